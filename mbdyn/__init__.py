@@ -1,0 +1,20 @@
+"""mbdyn -- multibody dynamics after *Dynamics of Machines II* (DTU).
+
+Assemble bodies, frames and joints into a tree (``System``), compile it to a ``Model``,
+evaluate kinematics, Jacobians, the Newton-Euler-Jourdain form ``M(q) u' = f`` or the
+Newton-Euler system with reactions, and integrate with ``simulate``.
+"""
+from . import inertia
+from .compile import Kinematics, Model
+from .elements import t
+from .errors import (ModelError, ModelWarning, NonFiniteError, SimulationError,
+                     SingularityWarning, SingularMassMatrixError)
+from .model import GROUND, System
+from .simulate import FIXED_STEP, INTEGRATORS, Event, Result, simulate
+
+__version__ = "0.1.0"
+
+__all__ = ["System", "Model", "Kinematics", "Result", "Event", "simulate", "inertia", "t",
+           "GROUND", "INTEGRATORS", "FIXED_STEP", "ModelError", "ModelWarning",
+           "NonFiniteError", "SimulationError", "SingularityWarning",
+           "SingularMassMatrixError"]

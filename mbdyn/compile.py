@@ -1,0 +1,549 @@
+"""The compiled, frozen ``Model``: flat arrays in topological order and the numeric API.
+
+``System.compile()`` (in ``mbdyn.model``) validates the tree and hands its elements here in
+topological order; this layer knows nothing of the tree, only of the element records.
+A changed parameter means a new compile, which is cheap (the kernels are compiled once per
+machine and cached by numba).
+
+State conventions: ``q`` (coordinates) and ``u`` (speeds) are the *free* ones, in the order
+``Model.coordinates`` / ``Model.speeds``; driven joints have no entry, their motion comes
+from their drives.  Vectors are in inertial (world) components unless stated.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import ModelError, NonFiniteError, SingularMassMatrixError
+from .kernels import dynamics as kd
+from .kernels import evaluate as ke
+from .kernels import joints as kj
+from .kernels.kinematics import point_jacobian
+
+METHODS = ("jourdain", "newton-euler")
+
+
+def _perpendicular_pair(a):
+    """Two unit vectors completing ``a`` to a right-handed orthonormal basis."""
+    helper = np.eye(3)[np.argmin(np.abs(a))]
+    n1 = np.cross(a, helper)
+    n1 /= np.linalg.norm(n1)
+    return n1, np.cross(a, n1)
+
+
+def reaction_basis(joint):
+    """Directions (child-frame components) of the reaction components a joint transmits:
+    ``[(force, moment), ...]`` -- six minus its degrees of freedom, plus the drive's."""
+    e = np.eye(3)
+    z = np.zeros(3)
+    kind = joint.kind
+    forces = [(e[k], z) for k in range(3)]
+    moments = [(z, e[k]) for k in range(3)]
+    if kind == "fixed":
+        basis = forces + moments
+    elif kind in ("spherical", "euler"):
+        basis = forces
+    elif kind == "free":
+        basis = []
+    elif kind == "revolute":
+        n1, n2 = _perpendicular_pair(joint.axis)
+        basis = forces + [(z, n1), (z, n2)]
+        if joint.drive is not None:
+            basis.append((z, joint.axis.copy()))
+    else:  # prismatic
+        n1, n2 = _perpendicular_pair(joint.axis)
+        basis = [(n1, z), (n2, z)] + moments
+        if joint.drive is not None:
+            basis.append((joint.axis.copy(), z))
+    return basis
+
+
+@dataclass(frozen=True)
+class Kinematics:
+    """Motion of every frame (rows in ``Model.frames`` order).
+
+    World components: ``R`` (``I s = R . B s``), ``r, v, a`` of frame origins, ``w, alpha``
+    angular velocity and acceleration, ``r_com, v_com, a_com`` of centres of mass.
+    Own-frame components (as the textbook writes them): ``w_body``, ``alpha_body``.
+    """
+    frames: tuple
+    R: np.ndarray
+    r: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    w: np.ndarray
+    alpha: np.ndarray
+    r_com: np.ndarray
+    v_com: np.ndarray
+    a_com: np.ndarray
+
+    @property
+    def T(self):
+        """The textbook's transformation matrices ``B s = T . I s`` (``R`` transposed)."""
+        return np.transpose(self.R, (0, 2, 1))
+
+    @property
+    def w_body(self):
+        return np.einsum("nji,nj->ni", self.R, self.w)
+
+    @property
+    def alpha_body(self):
+        return np.einsum("nji,nj->ni", self.R, self.alpha)
+
+    def frame(self, name):
+        """Index of a frame by name."""
+        return self.frames.index(name)
+
+
+class Model:
+    """A compiled multibody model (frozen).  Build it with ``System.compile()``.
+
+    Not thread-safe: evaluations share one preallocated workspace; every method returns
+    fresh arrays.
+    """
+
+    def __init__(self, name, bodies, joints, loads, gravity, warnings=()):
+        self.name = name
+        self.warnings = tuple(warnings)
+        self.gravity = np.array(gravity, dtype=float)
+        self.frames = tuple(b.name for b in bodies)
+        self.bodies = tuple(b.name for b in bodies if b.has_inertia)
+        self.joints = tuple(j.name for j in joints)
+        self._joint = {j.name: j for j in joints}
+        self._body = {b.name: b for b in bodies}
+        self._frame_index = {nm: i for i, nm in enumerate(self.frames)}
+        n = len(bodies)
+        self.n_frames = n
+        # -- tree arrays
+        self._parent = np.array([self._frame_index.get(j.parent, -1) for j in joints], np.int64)
+        self._kind = np.array([j.code for j in joints], np.int64)
+        self._axis = np.array([j.axis for j in joints], float).reshape(n, 3)
+        self._seq = np.array([j.sequence for j in joints], np.int64).reshape(n, 3)
+        self._pos = np.array([j.position for j in joints], float).reshape(n, 3)
+        self._C = np.array([j.orientation for j in joints], float).reshape(n, 3, 3)
+        qoff = np.zeros(n, np.int64)
+        uoff = np.zeros(n, np.int64)
+        ucol = -np.ones(n, np.int64)
+        free_q, free_u, coords, speeds = [], [], [], []
+        self._driven = []                 # (joint, qfull index, drive)
+        self._quaternions = []            # slices of q holding a quaternion
+        nqf = nuf = 0
+        for i, j in enumerate(joints):
+            qoff[i], uoff[i] = nqf, nuf
+            if j.drive is not None:
+                self._driven.append((j.name, nqf, j.drive))
+            elif j.nu:
+                ucol[i] = len(free_u)
+                start = len(free_q)
+                if j.kind == "spherical":
+                    self._quaternions.append(slice(start, start + 4))
+                elif j.kind == "free":
+                    self._quaternions.append(slice(start + 3, start + 7))
+                free_q.extend(range(nqf, nqf + j.nq))
+                free_u.extend(range(nuf, nuf + j.nu))
+                coords.extend(j.coordinates)
+                speeds.extend(j.speeds)
+            nqf += j.nq
+            nuf += j.nu
+        self._qoff, self._uoff, self._ucol = qoff, uoff, ucol
+        self._free_q = np.array(free_q, np.int64)
+        self._free_u = np.array(free_u, np.int64)
+        self.coordinates = tuple(coords)
+        self.speeds = tuple(speeds)
+        self.nq, self.nu = len(coords), len(speeds)
+        self._coordinate_index = {c: k for k, c in enumerate(coords)}
+        self._speed_index = {c: k for k, c in enumerate(speeds)}
+        self._speed_joint = []            # joint name of each speed
+        self._free_joint_slots = []       # (kind code, q start, nq, u start, nu)
+        qi = ui = 0
+        for j in joints:
+            if j.drive is None and j.nu:
+                self._free_joint_slots.append((j.code, qi, j.nq, ui, j.nu))
+                self._speed_joint.extend([j.name] * j.nu)
+                qi += j.nq
+                ui += j.nu
+        # columns each frame depends on: its own joint's and its ancestors'
+        cols = []
+        for i, j in enumerate(joints):
+            own = list(range(ucol[i], ucol[i] + j.nu)) if ucol[i] >= 0 else []
+            inherited = cols[self._parent[i]] if self._parent[i] >= 0 else []
+            cols.append(sorted(inherited + own))
+        self._anc_ptr = np.cumsum([0] + [len(c) for c in cols]).astype(np.int64)
+        self._anc_idx = np.array([c for cs in cols for c in cs], np.int64)
+        # -- body arrays
+        self._mass = np.array([b.mass for b in bodies], float)
+        self._com = np.array([b.com for b in bodies], float).reshape(n, 3)
+        self._inertia = np.array([b.inertia for b in bodies], float).reshape(n, 3, 3)
+        self._has_inertia = np.array([b.has_inertia for b in bodies], np.bool_)
+        # -- reactions
+        rj, rf, rm, self._reaction_slices = [], [], [], {}
+        for i, j in enumerate(joints):
+            basis = reaction_basis(j)
+            self._reaction_slices[j.name] = slice(len(rj), len(rj) + len(basis))
+            for fo, mo in basis:
+                rj.append(i)
+                rf.append(fo)
+                rm.append(mo)
+        self._react_joint = np.array(rj, np.int64)
+        self._react_force = np.array(rf, float).reshape(-1, 3)
+        self._react_moment = np.array(rm, float).reshape(-1, 3)
+        # -- loads
+        self.loads = tuple(ld.name for ld in loads)
+        nl = len(loads)
+        self._load_body = np.array([self._frame_index[ld.body] for ld in loads], np.int64)
+        self._load_point = np.array([ld.point for ld in loads], float).reshape(nl, 3)
+        self._load_in_body = np.array([ld.in_body for ld in loads], np.bool_)
+        self._load_force = np.zeros((nl, 3))
+        self._load_moment = np.zeros((nl, 3))
+        self._load_functions = []         # (load name, target array row, callable)
+        for k, ld in enumerate(loads):
+            for target, val in ((self._load_force, ld.force), (self._load_moment, ld.moment)):
+                if callable(val):
+                    self._load_functions.append((ld.name, target[k], val))
+                else:
+                    target[k] = val
+        # -- workspace
+        self._qfull = np.zeros(nqf)
+        self._ufull = np.zeros(nuf)
+        self._udfull = np.zeros(nuf)
+        for i, j in enumerate(joints):    # identity quaternions where nothing else is set
+            if j.kind == "spherical":
+                self._qfull[qoff[i]] = 1.0
+            elif j.kind == "free":
+                self._qfull[qoff[i] + 3] = 1.0
+        self._R = np.zeros((n, 3, 3))
+        self._r, self._w, self._v = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))
+        self._alpha, self._a = np.zeros((n, 3)), np.zeros((n, 3))
+        self._JR = np.zeros((n, 3, self.nu))
+        self._JT = np.zeros((n, 3, self.nu))
+        self._F, self._N = np.zeros((n, 3)), np.zeros((n, 3))
+        self._M = np.zeros((self.nu, self.nu))
+        self._f = np.zeros(self.nu)
+        self._L = np.zeros((self.nu, self.nu))
+        self._A = np.zeros((6 * n, 6 * n))
+        self._b = np.zeros(6 * n)
+        self._tree = (self._parent, self._kind, self._axis, self._seq, self._pos, self._C,
+                      self._qoff, self._uoff, self._ucol, self._anc_ptr, self._anc_idx)
+        self._loads_arrays = (self._load_body, self._load_point, self._load_force,
+                              self._load_moment, self._load_in_body)
+        self._kin_out = (self._R, self._r, self._w, self._v, self._alpha, self._a,
+                         self._JR, self._JT, self._F, self._N)
+
+    # ------------------------------------------------------------------ state helpers
+    def __repr__(self):
+        return (f"<Model {self.name!r}: {self.n_frames} frames, {len(self.joints)} joints, "
+                f"nq={self.nq}, nu={self.nu}>")
+
+    def joint(self, name):
+        """The joint record (kind, axis, parent, child, coordinates, drive...)."""
+        return self._joint[name]
+
+    def body(self, name):
+        """The body record (mass, com, inertia about the centre of mass)."""
+        return self._body[name]
+
+    def coordinate_index(self, name):
+        return self._coordinate_index[name]
+
+    def speed_index(self, name):
+        return self._speed_index[name]
+
+    def frame_index(self, name):
+        try:
+            return self._frame_index[name]
+        except KeyError:
+            raise ModelError(f"unknown frame {name!r}; the model's frames are "
+                             f"{', '.join(self.frames)}") from None
+
+    @property
+    def driven_joints(self):
+        return tuple(nm for nm, _, _ in self._driven)
+
+    def default_coordinates(self):
+        """Zero coordinates with identity quaternions."""
+        q = np.zeros(self.nq)
+        for s in self._quaternions:
+            q[s.start] = 1.0
+        return q
+
+    def q_vector(self, values=None):
+        """Coordinates as an array from an array, or a mapping ``{name: value}`` over the
+        defaults (unknown names are refused)."""
+        return self._vector(values, self.default_coordinates(), self._coordinate_index,
+                            "coordinate")
+
+    def u_vector(self, values=None):
+        """Speeds as an array from an array, or a mapping ``{name: value}`` over zeros."""
+        return self._vector(values, np.zeros(self.nu), self._speed_index, "speed")
+
+    def _vector(self, values, default, index, what):
+        if values is None:
+            return default
+        if isinstance(values, dict):
+            for k, val in values.items():
+                if k not in index:
+                    raise ModelError(f"unknown {what} {k!r}; the model's {what}s are "
+                                     f"{', '.join(index) or '(none)'}")
+                default[index[k]] = float(val)
+            return default
+        arr = np.array(values, dtype=float).reshape(-1)
+        if arr.shape != default.shape:
+            raise ModelError(f"expected {default.size} {what}s ({', '.join(index)}), "
+                             f"got {arr.size} values")
+        return arr
+
+    def normalize_quaternions(self, q):
+        """Project every joint quaternion in ``q`` back onto the unit sphere (in place);
+        returns the largest ``| |quat| - 1 |`` found before projection."""
+        drift = 0.0
+        for s in self._quaternions:
+            n = np.linalg.norm(q[s])
+            drift = max(drift, abs(n - 1.0))
+            q[s] /= n
+        return drift
+
+    def quaternion_drift(self, q):
+        """Largest ``| |quat| - 1 |`` over the joint quaternions in ``q`` (0 if none)."""
+        return max((abs(np.linalg.norm(q[s]) - 1.0) for s in self._quaternions), default=0.0)
+
+    # ------------------------------------------------------------------ evaluation core
+    def _fill(self, q, u, t):
+        """Scatter the free state and the drives into joint-space vectors; evaluate the
+        loads that are functions of ``(t, q, u)``."""
+        q = np.asarray(q, dtype=float)
+        u = np.asarray(u, dtype=float)
+        if q.shape != (self.nq,) or u.shape != (self.nu,):
+            raise ModelError(f"model {self.name!r} expects q of length {self.nq} and u of "
+                             f"length {self.nu}, got {q.shape} and {u.shape}")
+        self._qfull[self._free_q] = q
+        self._ufull[self._free_u] = u
+        self._udfull[:] = 0.0
+        for name, k, drive in self._driven:
+            self._qfull[k] = drive.position(t)
+            self._ufull[k] = drive.velocity(t)
+            self._udfull[k] = drive.acceleration(t)
+        for name, row, fn in self._load_functions:
+            val = np.asarray(fn(t, q, u), dtype=float).reshape(-1)
+            if val.shape != (3,):
+                raise ModelError(f"load {name!r}: its function returned {val.size} values at "
+                                 f"t={t}; it must return three")
+            row[:] = val
+        return q, u
+
+    def _check_finite(self, q, u, t, out, what):
+        if np.all(np.isfinite(out)):
+            return
+        if not np.all(np.isfinite(q)) or not np.all(np.isfinite(u)):
+            bad = [n for n, x in zip(self.coordinates + self.speeds, np.concatenate([q, u]))
+                   if not np.isfinite(x)]
+            raise NonFiniteError(f"model {self.name!r}, t={t:.6g}: the state holds non-finite "
+                                 f"values in {', '.join(bad)}")
+        for name, row, _ in self._load_functions:
+            if not np.all(np.isfinite(row)):
+                raise NonFiniteError(f"model {self.name!r}, t={t:.6g}: load {name!r} returned "
+                                     f"non-finite values {row.tolist()}")
+        for name, k, _ in self._driven:
+            if not (np.isfinite(self._qfull[k]) and np.isfinite(self._ufull[k])
+                    and np.isfinite(self._udfull[k])):
+                raise NonFiniteError(f"model {self.name!r}, t={t:.6g}: the drive of joint "
+                                     f"{name!r} gave a non-finite value")
+        bad = [n for n, x in zip(self.speeds, out) if not np.isfinite(x)]
+        raise NonFiniteError(f"model {self.name!r}, t={t:.6g}: {what} came out non-finite "
+                             f"for {', '.join(bad) or 'some entries'}")
+
+    def _kinematics_kernel(self, q, u, t, ud=None):
+        q, u = self._fill(q, u, t)
+        if ud is not None:
+            self._udfull[self._free_u] = ud
+        ke.kinematics_and_loads(*self._tree, self._mass, self._com, self.gravity,
+                                self._qfull, self._ufull, self._udfull, *self._loads_arrays,
+                                *self._kin_out)
+        return q, u
+
+    def _jourdain_terms(self, q, u, t):
+        q, u = self._kinematics_kernel(q, u, t)
+        kd.jourdain(self._mass, self._com, self._inertia, self._has_inertia, self._R, self._w,
+                    self._alpha, self._a, self._JR, self._JT, self._anc_ptr, self._anc_idx,
+                    self._F, self._N, self._M, self._f)
+        return q, u
+
+    # ------------------------------------------------------------------ public numerics
+    def kinematics(self, q, u=None, ud=None, t=0.0):
+        """Positions, velocities and accelerations of every frame and centre of mass.
+
+        With ``ud=None`` the accelerations are those at zero free speed rates (the
+        velocity-product part); pass ``ud`` for the full accelerations.
+        """
+        u = np.zeros(self.nu) if u is None else u
+        self._kinematics_kernel(q, u, t, ud)
+        R = self._R.copy()
+        c = np.einsum("nij,nj->ni", R, self._com)
+        w, al = self._w.copy(), self._alpha.copy()
+        return Kinematics(self.frames, R, self._r.copy(), self._v.copy(), self._a.copy(), w, al,
+                          self._r + c, self._v + np.cross(w, c),
+                          self._a + np.cross(al, c) + np.cross(w, np.cross(w, c)))
+
+    def jacobian_rotation(self, q, frame, t=0.0):
+        """``dw/du`` of a frame (3 x nu, world components)."""
+        i = self.frame_index(frame)
+        self._kinematics_kernel(q, np.zeros(self.nu), t)
+        return self._JR[i].copy()
+
+    def jacobian_translation(self, q, frame, point=None, t=0.0):
+        """``dv/du`` of a point fixed on a frame (3 x nu, world components).
+
+        ``point`` is in the frame's own components from its origin; default the centre of
+        mass of a body (the origin of a massless frame).
+        """
+        i = self.frame_index(frame)
+        self._kinematics_kernel(q, np.zeros(self.nu), t)
+        p = self._com[i] if point is None else np.asarray(point, dtype=float)
+        out = np.empty((3, self.nu))
+        point_jacobian(self._JT[i], self._JR[i], self._R[i] @ p, out)
+        return out
+
+    def mass_matrix(self, q, t=0.0):
+        """The Jourdain mass matrix ``M(q)`` (nu x nu, symmetric)."""
+        self._jourdain_terms(q, np.zeros(self.nu), t)
+        return self._M.copy()
+
+    def forcing(self, q, u, t=0.0):
+        """The right-hand side ``f(q, u, t)`` of ``M u' = f``: applied, gyroscopic and
+        velocity-product terms projected by the Jacobians."""
+        self._jourdain_terms(q, u, t)
+        return self._f.copy()
+
+    def forward_dynamics(self, q, u, t=0.0, method="jourdain"):
+        """Speed rates ``u'`` from ``M(q) u' = f(q, u, t)`` (``method="jourdain"``) or from
+        the Newton-Euler system with reactions (``method="newton-euler"``)."""
+        if method == "jourdain":
+            q, u = self._fill(q, u, t)
+            ud = np.empty(self.nu)
+            pivot = ke.jourdain_accelerations(
+                *self._tree, self._mass, self._com, self._inertia, self._has_inertia,
+                self.gravity, self._qfull, self._ufull, self._udfull, *self._loads_arrays,
+                *self._kin_out, self._M, self._f, self._L, ud)
+            if pivot >= 0:
+                self._raise_singular(q, t, pivot)
+        elif method == "newton-euler":
+            ud = self._newton_euler(q, u, t)[:self.nu].copy()
+        else:
+            raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")
+        self._check_finite(q, u, t, ud, "the accelerations")
+        return ud
+
+    def _newton_euler(self, q, u, t):
+        q, u = self._fill(q, u, t)
+        try:
+            x = ke.newton_euler_solution(
+                *self._tree, self._mass, self._com, self._inertia, self.gravity,
+                self._qfull, self._ufull, self._udfull, *self._loads_arrays,
+                self._react_joint, self._react_force, self._react_moment,
+                *self._kin_out, self._A, self._b)
+        except np.linalg.LinAlgError:
+            self._jourdain_terms(q, u, t)
+            self._raise_singular(q, t, None)
+        self._check_finite(q, u, t, x, "the Newton-Euler solution")
+        return x
+
+    def _raise_singular(self, q, t, pivot):
+        M = self._M
+        eigval, eigvec = np.linalg.eigh(0.5 * (M + M.T))
+        scale = max(abs(eigval).max(), 1e-300)
+        null = eigvec[:, eigval <= 1e-12 * scale]
+        if null.size:
+            weight = np.abs(null).max(axis=1)
+            names = [s for s, wgt in zip(self.speeds, weight) if wgt > 0.1]
+        else:
+            names = [self.speeds[pivot]] if pivot is not None else []
+        joints = sorted({self._speed_joint[self._speed_index[s]] for s in names})
+        raise SingularMassMatrixError(
+            f"model {self.name!r}, t={t:.6g}: the mass matrix is not positive definite; "
+            f"speeds {', '.join(names)} (joints {', '.join(joints)}) carry no inertia here "
+            "(smallest eigenvalue {:.3g}, largest {:.3g}).  Give the bodies they move mass "
+            "or inertia, or, for a configuration singularity such as Euler angles at "
+            "sin(theta)=0, use a spherical (quaternion) joint.".format(eigval[0], eigval[-1]),
+            names)
+
+    def newton_euler(self, q, u, t=0.0):
+        """Solve the Newton-Euler equations with reaction unknowns.
+
+        Returns ``(ud, reactions)``; ``reactions`` as in ``Model.reactions``.
+        """
+        x = self._newton_euler(q, u, t)
+        return x[:self.nu].copy(), self._reactions_from(x[self.nu:])
+
+    def _reactions_from(self, lam):
+        out = {}
+        for i, name in enumerate(self.joints):
+            s = self._reaction_slices[name]
+            R = self._R[i]
+            force = R @ (self._react_force[s].T @ lam[s])
+            moment = R @ (self._react_moment[s].T @ lam[s])
+            out[name] = (force, moment)
+        return out
+
+    def reactions(self, q, u, t=0.0, method="newton-euler"):
+        """Force and moment each joint's parent exerts on its child, reduced to the joint
+        origin (the child frame's origin), world components: ``{joint: (F[3], M[3])}``.
+
+        ``method="newton-euler"`` solves the system with reaction unknowns;
+        ``"jourdain"`` computes the accelerations from ``M u' = f`` and then the joint
+        wrenches by inverse dynamics from the leaves to the root.
+        """
+        if method == "newton-euler":
+            return self.newton_euler(q, u, t)[1]
+        if method != "jourdain":
+            raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")
+        ud = self.forward_dynamics(q, u, t)
+        self._kinematics_kernel(q, u, t, ud)
+        out = np.empty((self.n_frames, 6))
+        kd.joint_wrenches(self._mass, self._com, self._inertia, self._parent, self._R, self._r,
+                          self._w, self._alpha, self._a, self._F, self._N, out)
+        return {name: (out[i, :3].copy(), out[i, 3:].copy()) for i, name in enumerate(self.joints)}
+
+    def drive_efforts(self, q, u, t=0.0):
+        """Force or torque each driven joint needs to impose its motion: ``{joint: value}``
+        (the reaction component along the joint axis, in the axis' sense)."""
+        reac = self.reactions(q, u, t)
+        out = {}
+        for name, _, _ in self._driven:
+            j = self._joint[name]
+            i = self._frame_index[j.child]
+            axis_world = self._R[i] @ j.axis
+            f, m = reac[name]
+            out[name] = float(axis_world @ (m if j.kind == "revolute" else f))
+        return out
+
+    def coordinate_rates(self, q, u):
+        """Kinematic equations ``q' = N(q) u``; quaternion rates use the normalised
+        quaternion, so that ``|q|`` is an invariant of the exact flow."""
+        u = np.asarray(u, dtype=float)
+        if not self._quaternions:
+            return u.copy()
+        q = np.asarray(q, dtype=float)
+        qd = np.empty(self.nq)
+        for code, qi, nq, ui, nu in self._free_joint_slots:
+            kj.joint_coordinate_rates(code, q[qi:qi + nq], u[ui:ui + nu], qd[qi:qi + nq])
+        return qd
+
+    def energy(self, q, u, t=0.0):
+        """Kinetic and gravitational potential energy ``(T, V)``; ``V = -sum m g . r_G``."""
+        k = self.kinematics(q, u, t=t)
+        T = 0.0
+        V = 0.0
+        for i in range(self.n_frames):
+            R = k.R[i]
+            Iw = R @ self._inertia[i] @ R.T
+            T += 0.5 * self._mass[i] * k.v_com[i] @ k.v_com[i] + 0.5 * k.w[i] @ Iw @ k.w[i]
+            V -= self._mass[i] * self.gravity @ k.r_com[i]
+        return T, V
+
+    def mass_matrix_condition(self, q, t=0.0):
+        """2-norm condition number of ``M(q)`` (inf when singular)."""
+        M = self.mass_matrix(q, t)
+        if self.nu == 0:
+            return 1.0
+        ev = np.linalg.eigvalsh(M)
+        return float(ev[-1] / ev[0]) if ev[0] > 0 else float("inf")

@@ -1,0 +1,325 @@
+"""The elements a user assembles: bodies, joints, drives and loads, each validated on creation.
+
+These are plain records; the tree that connects them is ``mbdyn.model.System``.  Every
+error raised here names the element and says what to change.
+"""
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+import sympy
+
+from .errors import ModelError, ModelWarning
+from .kernels.joints import KIND_CODES, NQ, NU
+
+#: The time symbol for drive expressions: ``drive=Omega * mb.t``.
+t = sympy.Symbol("t", real=True)
+
+AXIS_NAMES = {"x": 0, "y": 1, "z": 2}
+
+
+def _vector3(value, what, element):
+    try:
+        arr = np.asarray(value, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise ModelError(f"{element}: {what} must be three numbers, got {value!r}") from None
+    if arr.shape != (3,):
+        raise ModelError(f"{element}: {what} must be three numbers, got {value!r}")
+    if not np.all(np.isfinite(arr)):
+        raise ModelError(f"{element}: {what} must be finite, got {value!r}")
+    return arr
+
+
+def parse_axis(axis, element):
+    """A unit vector from ``"x"``/``"-y"``/... or three numbers; refuses zero and non-finite."""
+    if isinstance(axis, str):
+        key = axis.strip().lower()
+        sign = -1.0 if key.startswith("-") else 1.0
+        key = key.lstrip("+-")
+        if key not in AXIS_NAMES:
+            raise ModelError(f"{element}: axis {axis!r} is not one of 'x', 'y', 'z' "
+                             "(optionally signed) or a vector of three numbers")
+        a = np.zeros(3)
+        a[AXIS_NAMES[key]] = sign
+        return a
+    a = _vector3(axis, "axis", element)
+    norm = np.linalg.norm(a)
+    if norm < 1e-12:
+        raise ModelError(f"{element}: axis {tuple(a)} has zero length; give a direction "
+                         "such as (0, 0, 1) or 'z'")
+    return a / norm
+
+
+def parse_orientation(orientation, element):
+    """Rotation matrix ``C`` of a joint frame in its parent (``P s = C . J s``).
+
+    Accepts None (identity), a 3x3 rotation matrix, a unit quaternion ``(w, x, y, z)``,
+    or an axis-angle pair ``(axis, angle)`` such as ``("z", pi/2)``.
+    """
+    if orientation is None:
+        return np.eye(3)
+    if (isinstance(orientation, (tuple, list)) and len(orientation) == 2
+            and not np.ndim(orientation[1])):
+        axis = parse_axis(orientation[0], element + " orientation")
+        angle = float(orientation[1])
+        K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+        return np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K
+    arr = np.asarray(orientation, dtype=float)
+    if arr.shape == (4,):
+        n = np.linalg.norm(arr)
+        if not np.isfinite(n) or abs(n - 1.0) > 1e-6:
+            raise ModelError(f"{element}: orientation quaternion {tuple(arr)} must have unit "
+                             f"length (it has {n:.6g}); normalise it")
+        w, x, y, z = arr / n
+        return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                         [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                         [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+    if arr.shape != (3, 3) or not np.all(np.isfinite(arr)):
+        raise ModelError(f"{element}: orientation must be a 3x3 rotation matrix, a unit "
+                         "quaternion (w, x, y, z) or (axis, angle)")
+    if (np.abs(arr.T @ arr - np.eye(3)).max() > 1e-8 or np.linalg.det(arr) < 0):
+        raise ModelError(f"{element}: orientation matrix is not a proper rotation "
+                         "(needs C^T C = I and det C = +1)")
+    return arr
+
+
+def parse_sequence(sequence, element):
+    """Axis indices of an Euler sequence such as ``"ZXZ"``; consecutive axes must differ."""
+    seq = "ZXZ" if sequence is None else str(sequence).upper()
+    if len(seq) != 3 or any(c not in "XYZ" for c in seq) or seq[0] == seq[1] or seq[1] == seq[2]:
+        raise ModelError(f"{element}: Euler sequence {sequence!r} is not valid; use three "
+                         "of X, Y, Z with no axis repeated twice in a row (e.g. 'ZXZ', 'XYZ')")
+    return tuple("XYZ".index(c) for c in seq)
+
+
+@dataclass(frozen=True)
+class Body:
+    """A frame with mass properties: ``mass``, centre of mass ``com`` (body components,
+    from the frame origin) and ``inertia`` about the centre of mass in body axes.
+    A massless frame is a body of mass 0 and no inertia."""
+    name: str
+    mass: float = 0.0
+    com: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    inertia: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
+
+    @property
+    def has_inertia(self):
+        return self.mass > 0.0 or bool(np.any(self.inertia != 0.0))
+
+
+def make_body(name, mass=0.0, com=(0, 0, 0), inertia=None):
+    """Validate and build a ``Body``; see ``System.add_body``."""
+    element = f"body {name!r}"
+    try:
+        mass = float(mass)
+    except (TypeError, ValueError):
+        raise ModelError(f"{element}: mass must be a number, got {mass!r}") from None
+    if not math.isfinite(mass) or mass < 0.0:
+        raise ModelError(f"{element}: mass must be finite and >= 0, got {mass!r}")
+    com = _vector3(com, "com", element)
+    inertia = inertia_tensor(inertia, element)
+    return Body(name, mass, com, inertia)
+
+
+def inertia_tensor(inertia, element):
+    """A symmetric positive semi-definite 3x3 tensor from None/0, three principal values or
+    a 3x3 matrix.  Warns when the principal moments break the triangle inequality."""
+    if inertia is None or (np.isscalar(inertia) and inertia == 0):
+        return np.zeros((3, 3))
+    try:
+        arr = np.asarray(inertia, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(f"{element}: inertia must be None, three principal moments or a "
+                         f"3x3 tensor, got {inertia!r}") from None
+    if arr.shape == (3,):
+        arr = np.diag(arr)
+    if arr.shape != (3, 3):
+        raise ModelError(f"{element}: inertia must be None, three principal moments or a "
+                         f"3x3 tensor, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ModelError(f"{element}: inertia has non-finite entries")
+    scale = max(np.abs(arr).max(), 1e-300)
+    if np.abs(arr - arr.T).max() > 1e-9 * scale:
+        raise ModelError(f"{element}: inertia tensor is not symmetric; "
+                         "I[i][j] must equal I[j][i]")
+    arr = 0.5 * (arr + arr.T)
+    principal = np.linalg.eigvalsh(arr)
+    if principal[0] < -1e-12 * scale:
+        raise ModelError(f"{element}: inertia tensor is not positive semi-definite "
+                         f"(principal moments {principal.tolist()}); moments of inertia "
+                         "cannot be negative")
+    a, b, c = np.sort(np.maximum(principal, 0.0))
+    if a + b < c * (1 - 1e-9):
+        warnings.warn(f"{element}: principal moments of inertia {a:.6g}, {b:.6g}, {c:.6g} "
+                      "about the centre of mass break the triangle inequality (A + B >= C); "
+                      "no real body has them.  Check the data (e.g. moments given about another "
+                      "point than the centre of mass).", ModelWarning, stacklevel=4)
+    return arr
+
+
+@dataclass(frozen=True)
+class Drive:
+    """A prescribed motion ``q(t)`` of a 1-DoF joint with its exact derivatives."""
+    position: Callable[[float], float]
+    velocity: Callable[[float], float]
+    acceleration: Callable[[float], float]
+    expression: sympy.Expr | None = None
+
+
+def make_drive(drive, element):
+    if drive is None:
+        return None
+    if isinstance(drive, Drive):
+        return drive
+    if isinstance(drive, (tuple, list)):
+        if len(drive) != 3 or not all(callable(f) for f in drive):
+            raise ModelError(f"{element}: drive must be a sympy expression of mb.t or three "
+                             "callables (q(t), q'(t), q''(t))")
+        return Drive(*drive)
+    try:
+        expr = sympy.sympify(drive) if isinstance(drive, (int, float)) else drive
+        free = expr.free_symbols
+    except AttributeError:
+        raise ModelError(f"{element}: drive must be a sympy expression of mb.t or three "
+                         f"callables (q(t), q'(t), q''(t)), got {drive!r}") from None
+    # accept any symbol named 't' as time, whatever its assumptions
+    other = {s for s in free if s.name != "t"}
+    if other:
+        names = ", ".join(sorted(s.name for s in other))
+        raise ModelError(f"{element}: drive depends on symbols {names} besides t; substitute "
+                         "numbers for them (expr.subs(...)) before adding the joint")
+    tsyms = [s for s in free if s.name == "t"]
+    expr = expr.subs({s: t for s in tsyms})
+    funcs = [sympy.lambdify(t, e, "math") for e in (expr, expr.diff(t), expr.diff(t, 2))]
+
+    def as_float(f):
+        return lambda time: float(f(time))
+    return Drive(*(as_float(f) for f in funcs), expression=expr)
+
+
+@dataclass(frozen=True)
+class Joint:
+    """A joint between ``parent`` and ``child`` frames; see ``System.add_joint``."""
+    name: str
+    kind: str
+    parent: str
+    child: str
+    axis: np.ndarray
+    position: np.ndarray
+    orientation: np.ndarray
+    sequence: tuple
+    coordinates: tuple
+    speeds: tuple
+    drive: Drive | None
+
+    @property
+    def code(self):
+        return KIND_CODES[self.kind]
+
+    @property
+    def nq(self):
+        return NQ[self.code]
+
+    @property
+    def nu(self):
+        return NU[self.code]
+
+
+def _default_names(name, kind, coordinates, speeds, element):
+    nq, nu = NQ[KIND_CODES[kind]], NU[KIND_CODES[kind]]
+    if kind in ("revolute", "prismatic"):
+        qn = (name,)
+    elif kind == "euler":
+        qn = tuple(f"{name}_{k}" for k in range(1, 4))
+    elif kind == "spherical":
+        qn = tuple(f"{name}_{k}" for k in ("qw", "qx", "qy", "qz"))
+    elif kind == "free":
+        qn = tuple(f"{name}_{k}" for k in ("x", "y", "z", "qw", "qx", "qy", "qz"))
+    else:
+        qn = ()
+    if coordinates is not None:
+        coordinates = (coordinates,) if isinstance(coordinates, str) else tuple(coordinates)
+        if len(coordinates) != nq:
+            raise ModelError(f"{element}: a {kind} joint has {nq} coordinate(s), "
+                             f"got names {coordinates}")
+        qn = coordinates
+    if speeds is not None:
+        speeds = (speeds,) if isinstance(speeds, str) else tuple(speeds)
+        if len(speeds) != nu:
+            raise ModelError(f"{element}: a {kind} joint has {nu} speed(s), got names {speeds}")
+        un = speeds
+    elif kind in ("revolute", "prismatic", "euler"):
+        un = tuple(f"{c}_dot" for c in qn)
+    elif kind == "spherical":
+        un = tuple(f"{name}_{k}" for k in ("wx", "wy", "wz"))
+    elif kind == "free":
+        un = tuple(f"{name}_{k}" for k in ("vx", "vy", "vz", "wx", "wy", "wz"))
+    else:
+        un = ()
+    for n in qn + un:
+        if not isinstance(n, str) or not n.isidentifier():
+            raise ModelError(f"{element}: coordinate/speed name {n!r} must be an identifier "
+                             "(letters, digits, underscore)")
+    return qn, un
+
+
+def make_joint(name, kind, parent, child, *, axis=None, position=(0, 0, 0), orientation=None,
+               sequence=None, coordinates=None, speeds=None, drive=None):
+    """Validate and build a ``Joint``; see ``System.add_joint``."""
+    element = f"joint {name!r}"
+    if kind not in KIND_CODES:
+        raise ModelError(f"{element}: unknown kind {kind!r}; use one of "
+                         + ", ".join(repr(k) for k in KIND_CODES))
+    if kind in ("revolute", "prismatic"):
+        if axis is None:
+            raise ModelError(f"{element}: a {kind} joint needs an axis, e.g. axis='z'")
+        axis = parse_axis(axis, element)
+    elif axis is not None:
+        raise ModelError(f"{element}: a {kind} joint takes no axis (remove axis=...)")
+    else:
+        axis = np.array([0.0, 0.0, 1.0])
+    if sequence is not None and kind != "euler":
+        raise ModelError(f"{element}: only an euler joint takes a sequence")
+    seq = parse_sequence(sequence, element) if kind == "euler" else (2, 0, 2)
+    position = _vector3(position, "position", element)
+    C = parse_orientation(orientation, element)
+    qn, un = _default_names(name, kind, coordinates, speeds, element)
+    drv = make_drive(drive, element)
+    if drv is not None and kind not in ("revolute", "prismatic"):
+        raise ModelError(f"{element}: only a revolute or prismatic joint can be driven "
+                         f"(this one is {kind})")
+    return Joint(name, kind, parent, child, axis, position, C, seq, qn, un, drv)
+
+
+@dataclass(frozen=True)
+class Load:
+    """A force at a point of a body and/or a moment on it; constants or functions of
+    ``(t, q, u)`` returning three numbers, in world or body components."""
+    name: str
+    body: str
+    force: object
+    moment: object
+    point: np.ndarray
+    in_body: bool
+
+
+def make_load(name, body, force=None, moment=None, point=(0, 0, 0), frame="world"):
+    element = f"load {name!r}"
+    if frame not in ("world", "body"):
+        raise ModelError(f"{element}: frame must be 'world' or 'body', got {frame!r}")
+    if force is None and moment is None:
+        raise ModelError(f"{element}: give a force, a moment or both")
+    parts = []
+    for what, val in (("force", force), ("moment", moment)):
+        if val is None:
+            parts.append(np.zeros(3))
+        elif callable(val):
+            parts.append(val)
+        else:
+            parts.append(_vector3(val, what, element))
+    point = _vector3(point, "point", element)
+    return Load(name, body, parts[0], parts[1], point, frame == "body")

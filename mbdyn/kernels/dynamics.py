@@ -1,0 +1,213 @@
+"""Applied loads, the Newton-Euler-Jourdain form and the Newton-Euler system with reactions.
+
+Everything in inertial (world) components.  Per body: mass ``m``, centre of mass ``com``
+(body components, from the frame origin) and inertia tensor ``inertia`` about the centre
+of mass in body axes.  Applied loads are reduced to each body's centre of mass:
+force ``F[i]`` and moment ``N[i]``.
+"""
+import numpy as np
+from numba import njit
+
+from .kinematics import cross
+
+
+@njit(cache=True)
+def applied_loads(mass, com, gravity, R, r, load_body, load_point, load_force, load_moment,
+                  load_in_body, F, N):
+    """Gravity and point loads reduced to each centre of mass (world components).
+
+    A load's force acts at ``load_point`` (body components); ``load_in_body`` says whether
+    its force and moment are given in body (1) or world (0) components.
+    """
+    n = mass.shape[0]
+    for i in range(n):
+        for k in range(3):
+            F[i, k] = mass[i] * gravity[k]
+            N[i, k] = 0.0
+    for m in range(load_body.shape[0]):
+        i = load_body[m]
+        if load_in_body[m]:
+            f = R[i] @ load_force[m]
+            mo = R[i] @ load_moment[m]
+        else:
+            f = load_force[m].copy()
+            mo = load_moment[m].copy()
+        lever = R[i] @ (load_point[m] - com[i])      # centre of mass -> point of action
+        mo += cross(lever, f)
+        for k in range(3):
+            F[i, k] += f[k]
+            N[i, k] += mo[k]
+
+
+@njit(cache=True)
+def body_terms(i, mass, com, inertia, R, w, alpha_b, a_b):
+    """Per body: lever ``c`` (origin -> centre of mass), world inertia ``Iw``, bias
+    acceleration of the centre of mass and the inertia moment ``Iw alpha_b + w x Iw w``."""
+    c = R[i] @ com[i]
+    Iw = R[i] @ inertia[i] @ R[i].T
+    wi = w[i]
+    aG_b = a_b[i] + cross(alpha_b[i], c) + cross(wi, cross(wi, c))
+    gyro = Iw @ alpha_b[i] + cross(wi, Iw @ wi)
+    return c, Iw, aG_b, gyro
+
+
+@njit(cache=True)
+def com_jacobian(i, c, JT, JR, anc_ptr, anc_idx, out):
+    """Translation Jacobian of body i's centre of mass over its ancestor columns."""
+    for m in range(anc_ptr[i], anc_ptr[i + 1]):
+        col = anc_idx[m]
+        out[0, col] = JT[i, 0, col] + JR[i, 1, col] * c[2] - JR[i, 2, col] * c[1]
+        out[1, col] = JT[i, 1, col] + JR[i, 2, col] * c[0] - JR[i, 0, col] * c[2]
+        out[2, col] = JT[i, 2, col] + JR[i, 0, col] * c[1] - JR[i, 1, col] * c[0]
+
+
+@njit(cache=True)
+def jourdain(mass, com, inertia, has_inertia, R, w, alpha_b, a_b, JR, JT, anc_ptr, anc_idx,
+             F, N, M, f):
+    """Newton-Euler-Jourdain: ``M = sum JT^T m JT + JR^T I JR`` and
+    ``f = sum JT^T (F - m a_bias) + JR^T (N - I alpha_bias - w x I w)``."""
+    nu = M.shape[0]
+    M[:, :] = 0.0
+    f[:] = 0.0
+    JG = np.zeros((3, nu))
+    IJ = np.zeros((3, nu))
+    for i in range(mass.shape[0]):
+        if not has_inertia[i]:
+            continue
+        m_i = mass[i]
+        c, Iw, aG_b, gyro = body_terms(i, mass, com, inertia, R, w, alpha_b, a_b)
+        com_jacobian(i, c, JT, JR, anc_ptr, anc_idx, JG)
+        fT = F[i] - m_i * aG_b
+        fR = N[i] - gyro
+        lo, hi = anc_ptr[i], anc_ptr[i + 1]
+        for m in range(lo, hi):
+            col = anc_idx[m]
+            for k in range(3):
+                IJ[k, col] = (Iw[k, 0] * JR[i, 0, col] + Iw[k, 1] * JR[i, 1, col]
+                              + Iw[k, 2] * JR[i, 2, col])
+        for m in range(lo, hi):
+            a_ = anc_idx[m]
+            f[a_] += (JG[0, a_] * fT[0] + JG[1, a_] * fT[1] + JG[2, a_] * fT[2]
+                      + JR[i, 0, a_] * fR[0] + JR[i, 1, a_] * fR[1] + JR[i, 2, a_] * fR[2])
+            for mm in range(lo, hi):
+                b_ = anc_idx[mm]
+                M[a_, b_] += (m_i * (JG[0, a_] * JG[0, b_] + JG[1, a_] * JG[1, b_]
+                                     + JG[2, a_] * JG[2, b_])
+                              + JR[i, 0, a_] * IJ[0, b_] + JR[i, 1, a_] * IJ[1, b_]
+                              + JR[i, 2, a_] * IJ[2, b_])
+
+
+@njit(cache=True)
+def cholesky_solve(M, f, L, x):
+    """Solve ``M x = f`` by Cholesky.  Returns -1, or the index of the first pivot that is
+    not positive (the coordinate where positive definiteness fails); ``L`` is workspace."""
+    n = M.shape[0]
+    scale = 0.0
+    for j in range(n):
+        scale = max(scale, abs(M[j, j]))
+    tiny = 1e-14 * scale if scale > 0.0 else 1e-300
+    for j in range(n):
+        s = M[j, j]
+        for k in range(j):
+            s -= L[j, k] * L[j, k]
+        if not (s > tiny):
+            return j
+        L[j, j] = np.sqrt(s)
+        for i in range(j + 1, n):
+            s = M[i, j]
+            for k in range(j):
+                s -= L[i, k] * L[j, k]
+            L[i, j] = s / L[j, j]
+    for i in range(n):                  # forward: L y = f
+        s = f[i]
+        for k in range(i):
+            s -= L[i, k] * x[k]
+        x[i] = s / L[i, i]
+    for i in range(n - 1, -1, -1):      # backward: L^T x = y
+        s = x[i]
+        for k in range(i + 1, n):
+            s -= L[k, i] * x[k]
+        x[i] = s / L[i, i]
+    return -1
+
+
+@njit(cache=True)
+def newton_euler_system(mass, com, inertia, parent, R, r, w, alpha_b, a_b, JR, JT,
+                        anc_ptr, anc_idx, F, N, react_joint, react_force, react_moment, A, b):
+    """Assemble the Newton-Euler equations with reaction unknowns, ``A x = b``.
+
+    Rows ``6i..6i+2``: Newton for body i at its centre of mass; rows ``6i+3..6i+5``: Euler
+    about its centre of mass.  Unknowns: the free speed rates ``ud`` (columns ``0..nu-1``)
+    and the reaction components ``lambda_k`` (column ``nu + k``).  Reaction component k
+    belongs to the joint whose child is frame ``react_joint[k]`` and acts on that child at
+    its origin with force ``R react_force[k]`` and moment ``R react_moment[k]`` (child
+    components); the parent receives the opposite.
+    """
+    n = mass.shape[0]
+    nu = JR.shape[2]
+    A[:, :] = 0.0
+    JG = np.zeros((3, nu))
+    for i in range(n):
+        c, Iw, aG_b, gyro = body_terms(i, mass, com, inertia, R, w, alpha_b, a_b)
+        com_jacobian(i, c, JT, JR, anc_ptr, anc_idx, JG)
+        m_i = mass[i]
+        for m in range(anc_ptr[i], anc_ptr[i + 1]):
+            col = anc_idx[m]
+            for k in range(3):
+                A[6 * i + k, col] = m_i * JG[k, col]
+                A[6 * i + 3 + k, col] = (Iw[k, 0] * JR[i, 0, col] + Iw[k, 1] * JR[i, 1, col]
+                                         + Iw[k, 2] * JR[i, 2, col])
+        for k in range(3):
+            b[6 * i + k] = F[i, k] - m_i * aG_b[k]
+            b[6 * i + 3 + k] = N[i, k] - gyro[k]
+    for k in range(react_joint.shape[0]):
+        i = react_joint[k]
+        col = nu + k
+        Fk = R[i] @ react_force[k]
+        Nk = R[i] @ react_moment[k]
+        lever = R[i] @ com[i]                        # child's centre of mass -> joint is -lever
+        Mi = Nk - cross(lever, Fk)
+        for q in range(3):
+            A[6 * i + q, col] -= Fk[q]
+            A[6 * i + 3 + q, col] -= Mi[q]
+        p = parent[i]
+        if p >= 0:
+            lever_p = r[i] - (r[p] + R[p] @ com[p])  # parent's centre of mass -> joint
+            Mp = Nk + cross(lever_p, Fk)
+            for q in range(3):
+                A[6 * p + q, col] += Fk[q]
+                A[6 * p + 3 + q, col] += Mp[q]
+
+
+@njit(cache=True)
+def joint_wrenches(mass, com, inertia, parent, R, r, w, alpha, a, F, N, out):
+    """Inverse dynamics, leaves to root: the force and moment (about the joint origin)
+    each parent exerts on its child, given the full accelerations; ``out[i] = (F, N)``.
+
+    An independent route to the reactions: it uses no reaction basis and no linear solve.
+    """
+    n = mass.shape[0]
+    for i in range(n):
+        for k in range(6):
+            out[i, k] = 0.0
+    # accumulate, per frame, the wrench its children draw (about each frame's own origin)
+    for i in range(n - 1, -1, -1):
+        c = R[i] @ com[i]
+        Iw = R[i] @ inertia[i] @ R[i].T
+        aG = a[i] + cross(alpha[i], c) + cross(w[i], cross(w[i], c))
+        # wrench needed at the origin from the parent, beyond what children take (already in out[i])
+        f = mass[i] * aG - F[i]
+        mG = Iw @ alpha[i] + cross(w[i], Iw @ w[i]) - N[i]
+        mo = mG + cross(c, f)                       # about the frame origin
+        for k in range(3):
+            out[i, k] += f[k]
+            out[i, 3 + k] += mo[k]
+        p = parent[i]
+        if p >= 0:
+            lever = r[i] - r[p]
+            fi = out[i, 0:3].copy()
+            mi = out[i, 3:6].copy()
+            mp = mi + cross(lever, fi)
+            for k in range(3):
+                out[p, k] += fi[k]
+                out[p, 3 + k] += mp[k]

@@ -1,0 +1,195 @@
+"""Joint kinds: the few formulas each kind needs, dispatched by integer code.
+
+A joint connects a parent frame P to a child frame B through a *joint frame* J0 that is
+fixed in P (placed by the joint's position and orientation).  For every kind this module
+gives, from the joint's own coordinates ``qj``, speeds ``uj`` and speed rates ``udj``:
+
+* ``Rrel`` -- rotation of B relative to J0, mapping B components to J0 components
+  (``J0 s = Rrel . B s``; the textbook's ``T`` is its transpose);
+* ``d`` -- position of B's origin relative to J0's origin, J0 components;
+* ``Hw`` -- relative angular velocity of B w.r.t. J0, **B components**: ``w_rel = Hw uj``;
+* ``Hv`` -- relative velocity of B's origin, **J0 components**: ``d' = Hv uj``;
+* ``hw``, ``hv`` -- the velocity-product parts ``Hw' uj`` and ``Hv' uj`` of the relative
+  accelerations (zero for every kind but the Euler-angle joint).
+"""
+import numpy as np
+from numba import njit
+
+FIXED, REVOLUTE, PRISMATIC, EULER, SPHERICAL, FREE = 0, 1, 2, 3, 4, 5
+KIND_CODES = {"fixed": FIXED, "revolute": REVOLUTE, "prismatic": PRISMATIC,
+              "euler": EULER, "spherical": SPHERICAL, "free": FREE}
+KIND_NAMES = {v: k for k, v in KIND_CODES.items()}
+# Number of coordinates q and speeds u of each kind, indexed by code.
+NQ = (0, 1, 1, 3, 4, 7)
+NU = (0, 1, 1, 3, 3, 6)
+MAX_NU = 6
+
+
+@njit(cache=True)
+def rotation_about_axis(axis, angle, out):
+    """Rodrigues: rotation by ``angle`` about the unit ``axis``; maps rotated to fixed comps."""
+    c = np.cos(angle)
+    s = np.sin(angle)
+    k = 1.0 - c
+    x, y, z = axis[0], axis[1], axis[2]
+    out[0, 0] = c + x * x * k
+    out[0, 1] = x * y * k - z * s
+    out[0, 2] = x * z * k + y * s
+    out[1, 0] = y * x * k + z * s
+    out[1, 1] = c + y * y * k
+    out[1, 2] = y * z * k - x * s
+    out[2, 0] = z * x * k - y * s
+    out[2, 1] = z * y * k + x * s
+    out[2, 2] = c + z * z * k
+
+
+@njit(cache=True)
+def rotation_about_coordinate_axis(k, angle, out):
+    """Rotation by ``angle`` about coordinate axis ``k`` (0=x, 1=y, 2=z); = T_k(angle)^T."""
+    c = np.cos(angle)
+    s = np.sin(angle)
+    out[:, :] = 0.0
+    i = (k + 1) % 3
+    j = (k + 2) % 3
+    out[k, k] = 1.0
+    out[i, i] = c
+    out[j, j] = c
+    out[i, j] = -s
+    out[j, i] = s
+
+
+@njit(cache=True)
+def quaternion_to_matrix(q, out):
+    """Rotation matrix of the quaternion ``q = (w, x, y, z)``, normalised first.
+
+    Normalising here makes the dynamics independent of any drift of ``|q|`` that an
+    integrator lets in; the drift itself is reported by the simulation.
+    """
+    n = np.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    w, x, y, z = q[0] / n, q[1] / n, q[2] / n, q[3] / n
+    out[0, 0] = 1.0 - 2.0 * (y * y + z * z)
+    out[0, 1] = 2.0 * (x * y - w * z)
+    out[0, 2] = 2.0 * (x * z + w * y)
+    out[1, 0] = 2.0 * (x * y + w * z)
+    out[1, 1] = 1.0 - 2.0 * (x * x + z * z)
+    out[1, 2] = 2.0 * (y * z - w * x)
+    out[2, 0] = 2.0 * (x * z - w * y)
+    out[2, 1] = 2.0 * (y * z + w * x)
+    out[2, 2] = 1.0 - 2.0 * (x * x + y * y)
+
+
+@njit(cache=True)
+def quaternion_rate(q, w, out):
+    """``q' = 1/2 q (x) (0, w)`` with ``w`` in the rotated (child) frame.
+
+    Uses the normalised ``q`` so that ``q . q' = 0``: the norm is an invariant of the
+    exact flow whatever its current value.
+    """
+    n = np.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    a, b, c, d = q[0] / n, q[1] / n, q[2] / n, q[3] / n
+    out[0] = 0.5 * (-b * w[0] - c * w[1] - d * w[2])
+    out[1] = 0.5 * (a * w[0] - d * w[1] + c * w[2])
+    out[2] = 0.5 * (d * w[0] + a * w[1] - b * w[2])
+    out[3] = 0.5 * (-c * w[0] + b * w[1] + a * w[2])
+
+
+@njit(cache=True)
+def _cross(a, b, out):
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
+
+
+@njit(cache=True)
+def euler_rate_matrix(seq, angles, Hw, hw, rates):
+    """Relative angular velocity of an Euler-angle joint, child components.
+
+    ``Rrel = R_{s0}(q0) R_{s1}(q1) R_{s2}(q2)`` (rotations about moving axes), so
+    ``w = R2^T R1^T e_{s0} q0' + R2^T e_{s1} q1' + e_{s2} q2'``.  Fills the columns of
+    ``Hw`` and the velocity product ``hw = Hw' q'``.
+    """
+    R1 = np.empty((3, 3))
+    R2 = np.empty((3, 3))
+    rotation_about_coordinate_axis(seq[1], angles[1], R1)
+    rotation_about_coordinate_axis(seq[2], angles[2], R2)
+    e0 = np.zeros(3)
+    e1 = np.zeros(3)
+    e2 = np.zeros(3)
+    e0[seq[0]] = 1.0
+    e1[seq[1]] = 1.0
+    e2[seq[2]] = 1.0
+    y = R1.T @ e0                      # R1^T e0
+    c0 = R2.T @ y
+    c1 = R2.T @ e1
+    for k in range(3):
+        Hw[k, 0] = c0[k]
+        Hw[k, 1] = c1[k]
+        Hw[k, 2] = e2[k]
+    # d/dt R^T(q) x = -q' e x (R^T x) + R^T x'
+    t0 = np.empty(3)
+    t1 = np.empty(3)
+    t2 = np.empty(3)
+    _cross(e1, y, t0)                  # e1 x (R1^T e0)
+    t0 = R2.T @ t0
+    _cross(e2, c0, t1)                 # e2 x c0
+    _cross(e2, c1, t2)                 # e2 x c1
+    for k in range(3):
+        dc0 = -rates[2] * t1[k] - rates[1] * t0[k]
+        dc1 = -rates[2] * t2[k]
+        hw[k] = dc0 * rates[0] + dc1 * rates[1]
+
+
+@njit(cache=True)
+def joint_motion(kind, axis, seq, qj, uj, Rrel, d, Hw, Hv, hw, hv):
+    """Relative motion of one joint; see the module docstring for the outputs."""
+    for k in range(3):
+        d[k] = 0.0
+        hw[k] = 0.0
+        hv[k] = 0.0
+        for c in range(MAX_NU):
+            Hw[k, c] = 0.0
+            Hv[k, c] = 0.0
+    if kind == FIXED:
+        Rrel[:, :] = np.eye(3)
+    elif kind == REVOLUTE:
+        rotation_about_axis(axis, qj[0], Rrel)
+        for k in range(3):
+            Hw[k, 0] = axis[k]
+    elif kind == PRISMATIC:
+        Rrel[:, :] = np.eye(3)
+        for k in range(3):
+            d[k] = axis[k] * qj[0]
+            Hv[k, 0] = axis[k]
+    elif kind == EULER:
+        R0 = np.empty((3, 3))
+        R1 = np.empty((3, 3))
+        R2 = np.empty((3, 3))
+        rotation_about_coordinate_axis(seq[0], qj[0], R0)
+        rotation_about_coordinate_axis(seq[1], qj[1], R1)
+        rotation_about_coordinate_axis(seq[2], qj[2], R2)
+        Rrel[:, :] = R0 @ R1 @ R2
+        euler_rate_matrix(seq, qj, Hw, hw, uj)
+    elif kind == SPHERICAL:
+        quaternion_to_matrix(qj, Rrel)
+        for k in range(3):
+            Hw[k, k] = 1.0
+    elif kind == FREE:
+        quaternion_to_matrix(qj[3:7], Rrel)
+        for k in range(3):
+            d[k] = qj[k]
+            Hv[k, k] = 1.0
+            Hw[k, 3 + k] = 1.0
+
+
+@njit(cache=True)
+def joint_coordinate_rates(kind, qj, uj, out):
+    """Kinematic equations ``q' = N(q) u`` of one joint."""
+    if kind == SPHERICAL:
+        quaternion_rate(qj, uj, out)
+    elif kind == FREE:
+        for k in range(3):
+            out[k] = uj[k]
+        quaternion_rate(qj[3:7], uj[3:6], out[3:7])
+    else:
+        for k in range(uj.shape[0]):
+            out[k] = uj[k]

@@ -1,0 +1,118 @@
+"""Forward kinematics of the tree and the Jacobians of translation and rotation.
+
+Steps 1-6 of the textbook, done for every frame in topological order (parents first).
+All outputs are in inertial (world) components unless a name says otherwise:
+
+* ``R[i]``  -- orientation of frame i: ``I s = R[i] . B_i s`` (the textbook's ``T`` is ``R^T``);
+* ``r, v, a`` -- position, velocity, acceleration of frame i's origin;
+* ``w, alpha`` -- absolute angular velocity and acceleration of frame i;
+* ``JR[i]``, ``JT[i]`` -- Jacobians of rotation ``dw_i/du`` and of translation of the
+  origin ``dv_i/du``, over the free speeds ``u`` (driven joints have no column).
+
+The accelerations use the speed rates passed in ``udfull``: with zeros for the free
+speeds they are the velocity-product ("bias") accelerations, so that
+``a = JT ud + a_bias`` and ``alpha = JR ud + alpha_bias``.
+"""
+import numpy as np
+from numba import njit
+
+from .joints import MAX_NU, joint_motion
+
+
+@njit(cache=True)
+def cross(a, b):
+    return np.array((a[1] * b[2] - a[2] * b[1],
+                     a[2] * b[0] - a[0] * b[2],
+                     a[0] * b[1] - a[1] * b[0]))
+
+
+@njit(cache=True)
+def forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
+                       qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT):
+    """Motion of every frame and the Jacobians at frame origins (see module docstring).
+
+    ``anc_idx[anc_ptr[i]:anc_ptr[i+1]]`` lists the free-speed columns on which frame i
+    depends (its own joint's and its ancestors'); the other columns of ``JR[i]`` and
+    ``JT[i]`` are zero and are never written, so the caller zeroes them once.
+    """
+    n = parent.shape[0]
+    Rrel = np.empty((3, 3))
+    d = np.empty(3)
+    Hw = np.empty((3, MAX_NU))
+    Hv = np.empty((3, MAX_NU))
+    hw = np.empty(3)
+    hv = np.empty(3)
+    zero3 = np.zeros(3)
+    eye3 = np.eye(3)
+    for i in range(n):
+        p = parent[i]
+        if p >= 0:
+            Rp = R[p]
+            rp, wp, vp, alp, ap = r[p], w[p], v[p], alpha[p], a[p]
+        else:
+            Rp = eye3
+            rp, wp, vp, alp, ap = zero3, zero3, zero3, zero3, zero3
+        k0 = qoff[i]
+        j0 = uoff[i]
+        kd = kind[i]
+        nu = 0 if kd == 0 else (1 if kd <= 2 else (3 if kd <= 4 else 6))
+        nq = 0 if kd == 0 else (1 if kd <= 2 else (3 if kd == 3 else (4 if kd == 4 else 7)))
+        qj = qfull[k0:k0 + nq]
+        uj = ufull[j0:j0 + nu]
+        udj = udfull[j0:j0 + nu]
+        joint_motion(kd, axis[i], seq[i], qj, uj, Rrel, d, Hw, Hv, hw, hv)
+
+        RJ0 = Rp @ C[i]
+        R[i] = RJ0 @ Rrel
+        rho = Rp @ pos[i] + RJ0 @ d                  # parent origin -> child origin
+        r[i] = rp + rho
+        # relative velocities and accelerations of the joint
+        wrel_b = np.zeros(3)
+        dwrel_b = hw.copy()
+        vrel_j = np.zeros(3)
+        dvrel_j = hv.copy()
+        for c in range(nu):
+            for k in range(3):
+                wrel_b[k] += Hw[k, c] * uj[c]
+                dwrel_b[k] += Hw[k, c] * udj[c]
+                vrel_j[k] += Hv[k, c] * uj[c]
+                dvrel_j[k] += Hv[k, c] * udj[c]
+        wrel = R[i] @ wrel_b
+        vrel = RJ0 @ vrel_j
+        w[i] = wp + wrel
+        v[i] = vp + cross(wp, rho) + vrel
+        alpha[i] = alp + cross(wp, wrel) + R[i] @ dwrel_b
+        a[i] = (ap + cross(alp, rho) + cross(wp, cross(wp, rho))
+                + 2.0 * cross(wp, vrel) + RJ0 @ dvrel_j)
+
+        # Jacobians: inherit the parent's columns, then add this joint's own
+        if p >= 0:
+            for m in range(anc_ptr[p], anc_ptr[p + 1]):
+                col = anc_idx[m]
+                jr0, jr1, jr2 = JR[p, 0, col], JR[p, 1, col], JR[p, 2, col]
+                JR[i, 0, col] = jr0
+                JR[i, 1, col] = jr1
+                JR[i, 2, col] = jr2
+                # v_i = v_p + w_p x rho  ->  JT_i = JT_p - [rho]x JR_p
+                JT[i, 0, col] = JT[p, 0, col] + jr1 * rho[2] - jr2 * rho[1]
+                JT[i, 1, col] = JT[p, 1, col] + jr2 * rho[0] - jr0 * rho[2]
+                JT[i, 2, col] = JT[p, 2, col] + jr0 * rho[1] - jr1 * rho[0]
+        if ucol[i] >= 0:
+            Hw_w = R[i] @ Hw
+            Hv_w = RJ0 @ Hv
+            for c in range(nu):
+                col = ucol[i] + c
+                for k in range(3):
+                    JR[i, k, col] = Hw_w[k, c]
+                    JT[i, k, col] = Hv_w[k, c]
+
+
+@njit(cache=True)
+def point_jacobian(JT_origin, JR, offset_world, out):
+    """Translation Jacobian of a point fixed on a frame: ``JT_P = JT_O - [r_OP]x JR``."""
+    ncol = JR.shape[1]
+    x, y, z = offset_world[0], offset_world[1], offset_world[2]
+    for c in range(ncol):
+        out[0, c] = JT_origin[0, c] + JR[1, c] * z - JR[2, c] * y
+        out[1, c] = JT_origin[1, c] + JR[2, c] * x - JR[0, c] * z
+        out[2, c] = JT_origin[2, c] + JR[0, c] * y - JR[1, c] * x

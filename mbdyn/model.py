@@ -1,0 +1,197 @@
+"""``System``: what a user assembles -- a tree of frames (nodes) joined by joints (edges).
+
+The tree lives in a networkx ``DiGraph`` rooted at the frame ``"ground"``.  Elements are
+validated when added; the tree as a whole (connectivity, inertia of every degree of
+freedom) at ``compile()``.  Every error names the element and says what to change.
+"""
+from __future__ import annotations
+
+import warnings
+
+import networkx as nx
+import numpy as np
+
+from .compile import Model
+from .elements import inertia_tensor, make_body, make_joint, make_load
+from .errors import ModelError, ModelWarning, SingularMassMatrixError
+
+GROUND = "ground"
+
+
+class System:
+    """A multibody system under construction.
+
+    ``gravity`` is the gravitational acceleration vector in world components
+    (default ``(0, 0, -9.81)``).
+    """
+
+    def __init__(self, name="system", gravity=(0.0, 0.0, -9.81)):
+        self.name = str(name)
+        g = np.asarray(gravity, dtype=float).reshape(-1)
+        if g.shape != (3,) or not np.all(np.isfinite(g)):
+            raise ModelError(f"system {name!r}: gravity must be three finite numbers, "
+                             f"got {gravity!r}")
+        self.gravity = g
+        self.graph = nx.DiGraph()
+        self.graph.add_node(GROUND, body=make_body(GROUND))
+        self._joints = {}
+        self._loads = {}
+
+    # ------------------------------------------------------------------ building
+    def _check_new_frame(self, name):
+        if not isinstance(name, str) or not name:
+            raise ModelError(f"frame name must be a non-empty string, got {name!r}")
+        if name in self.graph:
+            what = "the ground frame" if name == GROUND else "a frame"
+            raise ModelError(f"body/frame {name!r}: the name is already used by {what}; "
+                             "choose another name")
+
+    def add_body(self, name, mass=0.0, com=(0, 0, 0), inertia=None):
+        """A rigid body: ``mass``, centre of mass ``com`` in body components (from the
+        frame origin), ``inertia`` about the centre of mass in body axes -- ``None``/0 for a
+        particle, three principal moments, or a 3x3 tensor (see ``mbdyn.inertia``)."""
+        self._check_new_frame(name)
+        self.graph.add_node(name, body=make_body(name, mass, com, inertia))
+        return name
+
+    def add_frame(self, name):
+        """A massless frame (e.g. a gimbal ring or an intermediate joint frame)."""
+        self._check_new_frame(name)
+        self.graph.add_node(name, body=make_body(name))
+        return name
+
+    def add_joint(self, name, kind, parent, child, *, axis=None, position=(0, 0, 0),
+                  orientation=None, sequence=None, coordinates=None, speeds=None, drive=None):
+        """Join ``child`` to ``parent``.
+
+        ``kind``: ``"revolute"`` / ``"prismatic"`` (need ``axis``, a vector or
+        ``"x"``/``"y"``/``"z"``, in the joint frame), ``"euler"`` (three rotations about
+        moving axes, ``sequence`` default ``"ZXZ"``), ``"spherical"`` (unit quaternion),
+        ``"fixed"``, ``"free"``.  ``position`` and ``orientation`` place the joint frame in
+        the parent frame (orientation: 3x3 matrix ``P s = C J s``, quaternion ``(w,x,y,z)``
+        or ``(axis, angle)``).  ``coordinates`` (and ``speeds``) name the joint's
+        coordinates; ``drive`` prescribes ``q(t)`` of a 1-DoF joint (a sympy expression of
+        ``mb.t`` or three callables ``(q, q', q'')``).
+        """
+        element = f"joint {name!r}"
+        if not isinstance(name, str) or not name:
+            raise ModelError(f"joint name must be a non-empty string, got {name!r}")
+        if name in self._joints:
+            raise ModelError(f"{element}: the name is already used by another joint")
+        for role, frame in (("parent", parent), ("child", child)):
+            if frame not in self.graph:
+                raise ModelError(f"{element}: unknown {role} frame {frame!r}; add it first "
+                                 "with add_body or add_frame (known: "
+                                 f"{', '.join(self.graph.nodes)})")
+        if child == GROUND:
+            raise ModelError(f"{element}: the ground cannot be a child; swap parent and child")
+        if child == parent:
+            raise ModelError(f"{element}: parent and child are both {child!r}")
+        existing = next(iter(self.graph.in_edges(child, data="joint")), None)
+        if existing is not None:
+            raise ModelError(f"{element}: frame {child!r} already has a parent joint "
+                             f"{existing[2].name!r}; closed loops are not supported -- a "
+                             "frame hangs from exactly one joint")
+        if nx.has_path(self.graph, child, parent):
+            raise ModelError(f"{element}: joining {parent!r} -> {child!r} closes a cycle "
+                             f"({child!r} is already an ancestor of {parent!r}); the system "
+                             "must be a tree")
+        joint = make_joint(name, kind, parent, child, axis=axis, position=position,
+                           orientation=orientation, sequence=sequence, coordinates=coordinates,
+                           speeds=speeds, drive=drive)
+        names_in_use = {c for j in self._joints.values() for c in j.coordinates + j.speeds}
+        clash = names_in_use.intersection(joint.coordinates + joint.speeds)
+        if clash:
+            raise ModelError(f"{element}: coordinate/speed names {sorted(clash)} are already "
+                             "used by another joint; pass coordinates=(...) to rename them")
+        self._joints[name] = joint
+        self.graph.add_edge(parent, child, joint=joint)
+        return name
+
+    def add_load(self, name, body, force=None, moment=None, point=(0, 0, 0), frame="world"):
+        """A force (acting at ``point``, body components) and/or a moment on ``body``.
+
+        ``force``/``moment``: three numbers, or a function ``f(t, q, u)`` returning three
+        numbers (``q``, ``u`` arrays in ``Model.coordinates``/``Model.speeds`` order);
+        ``frame``: ``"world"`` or ``"body"`` components.
+        """
+        if name in self._loads:
+            raise ModelError(f"load {name!r}: the name is already used by another load")
+        if body not in self.graph or body == GROUND:
+            raise ModelError(f"load {name!r}: unknown body {body!r}; loads act on bodies "
+                             f"added with add_body (known: "
+                             f"{', '.join(n for n in self.graph if n != GROUND)})")
+        self._loads[name] = make_load(name, body, force, moment, point, frame)
+        return name
+
+    # ------------------------------------------------------------------ inspection
+    @property
+    def bodies(self):
+        return {n: d["body"] for n, d in self.graph.nodes(data=True) if n != GROUND}
+
+    @property
+    def joints(self):
+        return dict(self._joints)
+
+    @property
+    def loads(self):
+        return dict(self._loads)
+
+    # ------------------------------------------------------------------ compile
+    def topological_frames(self):
+        """Non-ground frames, parents before children (raises if any is not connected)."""
+        reachable = nx.descendants(self.graph, GROUND)
+        orphans = [n for n in self.graph if n != GROUND and n not in reachable]
+        if orphans:
+            raise ModelError(f"system {self.name!r}: frames {', '.join(orphans)} are not "
+                             "connected to the ground; join each (or its topmost parent) to "
+                             "'ground' or to a connected frame with add_joint")
+        return [n for n in nx.topological_sort(self.graph) if n != GROUND]
+
+    def compile(self, check_inertia=True):
+        """Validate the whole tree and return a frozen ``Model``.
+
+        ``check_inertia`` evaluates the mass matrix at a few random configurations and
+        refuses degrees of freedom that carry no inertia (a singular ``M``), naming them.
+        """
+        order = self.topological_frames()
+        if not order:
+            raise ModelError(f"system {self.name!r} has no bodies; add bodies and joints")
+        bodies = [self.graph.nodes[n]["body"] for n in order]
+        joints = [next(iter(self.graph.in_edges(n, data="joint")))[2] for n in order]
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            for b in bodies:            # re-run the checks so the model carries the warnings
+                inertia_tensor(b.inertia, f"body {b.name!r}")
+        found = [str(w.message) for w in caught if issubclass(w.category, ModelWarning)]
+        model = Model(self.name, bodies, joints, list(self._loads.values()), self.gravity,
+                      warnings=found)
+        if check_inertia and model.nu:
+            _check_inertia_of_every_dof(model)
+        return model
+
+
+def _check_inertia_of_every_dof(model, samples=3, seed=12345):
+    """Refuse degrees of freedom that carry no inertia in any configuration.
+
+    A configuration singularity (Euler angles at ``sin(theta) = 0``) is singular at some
+    states only; a degree of freedom without inertia is singular at all of them.
+    """
+    rng = np.random.default_rng(seed)
+    singular_sets = []
+    for _ in range(samples):
+        q = model.default_coordinates() + rng.uniform(-1.0, 1.0, model.nq)
+        model.normalize_quaternions(q)
+        try:
+            model.mass_matrix(q)
+            model.forward_dynamics(q, np.zeros(model.nu))
+            return
+        except SingularMassMatrixError as exc:
+            singular_sets.append(set(exc.coordinates))
+    names = sorted(set.intersection(*singular_sets), key=model.speeds.index) or \
+        sorted(set.union(*singular_sets), key=model.speeds.index)
+    joints = sorted({model._speed_joint[model.speed_index(s)] for s in names})
+    raise ModelError(f"system {model.name!r}: degrees of freedom {', '.join(names)} (joints "
+                     f"{', '.join(joints)}) carry no inertia -- the mass matrix is singular in "
+                     "every configuration.  Give the bodies these joints move mass or inertia "
+                     "about the joint axes, or remove (fix) those joints.")

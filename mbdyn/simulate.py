@@ -1,0 +1,396 @@
+"""Time integration of ``q' = N(q) u``, ``u' = forward_dynamics(q, u, t)``; events; ``Result``.
+
+Adaptive integrators are scipy's ``OdeSolver`` classes (RK45, RK23, DOP853, Radau, BDF,
+LSODA), stepped here one accepted step at a time so that events are located on the dense
+output, a failure keeps the results computed before it, and NaN/Inf stops the run with the
+time and the state.  Fixed-step schemes: explicit Euler, semi-implicit (symplectic) Euler --
+the textbook's scheme, velocities first, then positions with the new velocities -- and
+classic RK4; quaternions are projected back onto the unit sphere after every step.
+"""
+from __future__ import annotations
+
+import time as _time
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import integrate, optimize
+
+from .errors import ModelError, NonFiniteError, SimulationError, SingularMassMatrixError
+
+ADAPTIVE = {"RK45": integrate.RK45, "RK23": integrate.RK23, "DOP853": integrate.DOP853,
+            "Radau": integrate.Radau, "BDF": integrate.BDF, "LSODA": integrate.LSODA}
+FIXED_STEP = ("euler", "semi-implicit-euler", "rk4")
+INTEGRATORS = tuple(ADAPTIVE) + FIXED_STEP
+OUTPUTS = ("reactions", "energy")
+
+
+@dataclass(frozen=True)
+class Event:
+    """A zero crossing of ``condition(t, q, u)``; ``direction`` +1 (rising), -1 (falling)
+    or 0 (either); a ``terminal`` event stops the run."""
+    name: str
+    condition: object
+    terminal: bool = False
+    direction: int = 0
+
+
+def _as_event(e):
+    if isinstance(e, Event):
+        return e
+    if isinstance(e, dict):
+        return Event(**e)
+    if isinstance(e, (tuple, list)):
+        return Event(*e)
+    raise ModelError(f"event {e!r}: give an mb.Event(name, condition, terminal, direction)")
+
+
+class Result:
+    """Time series of a simulation.
+
+    ``t`` (n,), ``q`` (n, nq), ``u`` (n, nu); ``res["theta1"]`` gives a coordinate or speed
+    by name; ``events`` is ``[(name, t), ...]``; ``stats`` the integrator's statistics;
+    on request ``reactions`` ``{joint: (n, 6)}`` (force then moment, world components, at
+    the joint origin), ``energy`` ``{"kinetic", "potential", "total"}`` and ``points``
+    ``{name: (n, 3)}``.
+    """
+
+    def __init__(self, model, t, q, u, events, stats):
+        self.model = model
+        self.t = np.asarray(t, dtype=float)
+        self.q = np.asarray(q, dtype=float).reshape(len(self.t), model.nq)
+        self.u = np.asarray(u, dtype=float).reshape(len(self.t), model.nu)
+        self.events = list(events)
+        self.stats = dict(stats)
+        self.reactions = None
+        self.energy = None
+        self.points = None
+        self.drive_efforts = None
+
+    @property
+    def coordinates(self):
+        return self.model.coordinates
+
+    @property
+    def speeds(self):
+        return self.model.speeds
+
+    def __len__(self):
+        return len(self.t)
+
+    def __getitem__(self, name):
+        if name in self.model.coordinates:
+            return self.q[:, self.model.coordinate_index(name)]
+        if name in self.model.speeds:
+            return self.u[:, self.model.speed_index(name)]
+        if self.points and name in self.points:
+            return self.points[name]
+        raise KeyError(f"{name!r} is neither a coordinate ({', '.join(self.coordinates)}) nor a "
+                       f"speed ({', '.join(self.speeds)}) of model {self.model.name!r}")
+
+    def __repr__(self):
+        return (f"<Result {self.model.name!r}: {len(self.t)} samples, t = {self.t[0]:g} .. "
+                f"{self.t[-1]:g}, events {self.events}>")
+
+    def compute_outputs(self, outputs=(), points=None, method="newton-euler"):
+        """Evaluate reactions, energies and point trajectories along the stored motion."""
+        model = self.model
+        unknown = set(outputs) - set(OUTPUTS)
+        if unknown:
+            raise ModelError(f"unknown outputs {sorted(unknown)}; choose from {OUTPUTS}")
+        n = len(self.t)
+        if "reactions" in outputs:
+            reac = {j: np.empty((n, 6)) for j in model.joints}
+            efforts = {j: np.empty(n) for j in model.driven_joints}
+            for k in range(n):
+                r = model.reactions(self.q[k], self.u[k], self.t[k], method=method)
+                for j, (f, m) in r.items():
+                    reac[j][k, :3] = f
+                    reac[j][k, 3:] = m
+                for j, val in model.drive_efforts(self.q[k], self.u[k], self.t[k]).items():
+                    efforts[j][k] = val
+            self.reactions = reac
+            self.drive_efforts = efforts
+        if "energy" in outputs:
+            TV = np.array([model.energy(self.q[k], self.u[k], self.t[k]) for k in range(n)])
+            self.energy = {"kinetic": TV[:, 0], "potential": TV[:, 1],
+                           "total": TV[:, 0] + TV[:, 1]}
+            E0 = self.energy["total"][0]
+            scale = max(abs(E0), np.abs(TV).max(), 1e-300)
+            self.stats["energy_drift"] = float(np.abs(self.energy["total"] - E0).max() / scale)
+        if points:
+            self.points = {}
+            for pname, (frame, offset) in points.items():
+                i = model.frame_index(frame)
+                off = np.asarray(offset, dtype=float)
+                traj = np.empty((n, 3))
+                for k in range(n):
+                    kin = model.kinematics(self.q[k], self.u[k], t=self.t[k])
+                    traj[k] = kin.r[i] + kin.R[i] @ off
+                self.points[pname] = traj
+        return self
+
+
+class _RightHandSide:
+    """``y = [q, u] -> [q', u']`` counting evaluations; NaN/Inf becomes an error."""
+
+    def __init__(self, model, method):
+        self.model = model
+        self.method = method
+        self.nq = model.nq
+        self.evaluations = 0
+
+    def __call__(self, t, y):
+        self.evaluations += 1
+        q = y[:self.nq]
+        u = y[self.nq:]
+        out = np.empty_like(y)      # a fresh array: scipy's solvers keep what they are given
+        out[:self.nq] = self.model.coordinate_rates(q, u)
+        out[self.nq:] = self.model.forward_dynamics(q, u, t, method=self.method)
+        return out
+
+
+def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator="RK45", rtol=1e-6,
+             atol=1e-9, dt=None, method="jourdain", events=(), t_eval=None, max_step=np.inf,
+             outputs=(), points=None, progress=None):
+    """Integrate ``model`` from ``t0`` to ``t_end``.
+
+    ``q0``/``u0``: arrays or ``{name: value}`` over the defaults (zero, identity
+    quaternions).  ``integrator``: one of ``INTEGRATORS``; the fixed-step ones need ``dt``.
+    ``method``: ``"jourdain"`` or ``"newton-euler"``.  ``events``: ``Event``s.  ``t_eval``:
+    output times (default every accepted step).  ``outputs``: any of ``"reactions"``,
+    ``"energy"``; ``points``: ``{name: (frame, offset)}``.  ``progress``: optional callable
+    ``progress(t)`` called after each step.
+
+    Raises ``SimulationError`` (its ``result`` holds the motion up to the failure) when
+    the integrator fails or NaN/Inf appears.
+    """
+    if integrator not in INTEGRATORS:
+        raise ModelError(f"unknown integrator {integrator!r}; use one of {', '.join(INTEGRATORS)}")
+    if method not in ("jourdain", "newton-euler"):
+        raise ModelError(f"unknown method {method!r}; use 'jourdain' or 'newton-euler'")
+    t0, t_end = float(t0), float(t_end)
+    if not t_end > t0:
+        raise ModelError(f"t_end ({t_end}) must be greater than t0 ({t0})")
+    q = model.q_vector(None if q0 is None else (dict(q0) if isinstance(q0, dict) else q0)).copy()
+    u = model.u_vector(None if u0 is None else (dict(u0) if isinstance(u0, dict) else u0)).copy()
+    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(u))):
+        raise ModelError("initial state must be finite")
+    model.normalize_quaternions(q)
+    events = [_as_event(e) for e in events]
+    rhs = _RightHandSide(model, method)
+    y0 = np.concatenate([q, u])
+    start = _time.perf_counter()
+    if integrator in ADAPTIVE:
+        ts, ys, found, info = _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol,
+                                            max_step, events, t_eval, progress)
+    else:
+        if dt is None or not dt > 0:
+            raise ModelError(f"integrator {integrator!r} is fixed-step: give dt > 0")
+        ts, ys, found, info = _run_fixed(rhs, integrator, t0, t_end, y0, float(dt), events,
+                                         t_eval, progress)
+    wall = _time.perf_counter() - start
+    ys = np.asarray(ys).reshape(len(ts), -1)
+    stats = {"integrator": integrator, "method": method, "rtol": rtol, "atol": atol, "dt": dt,
+             "rhs_evaluations": rhs.evaluations, "wall_time_s": wall,
+             "quaternion_drift": max((model.quaternion_drift(y[:model.nq]) for y in ys),
+                                     default=0.0)}
+    stats.update(info)
+    failure = stats.pop("failure", None)
+    qs = ys[:, :model.nq].copy()
+    for row in qs:                      # report unit quaternions; the drift is in stats
+        model.normalize_quaternions(row)
+    result = Result(model, ts, qs, ys[:, model.nq:], found, stats)
+    if failure is not None:
+        stats["status"] = "failed"
+        result.stats = stats
+        raise SimulationError(failure, result)
+    result.stats["status"] = "ok"
+    if outputs or points:
+        result.compute_outputs(outputs, points, method="newton-euler")
+    return result
+
+
+def _describe_failure(model, exc, t, y):
+    names = model.coordinates + model.speeds
+    state = ", ".join(f"{n}={v:.6g}" for n, v in zip(names, y))
+    return f"{exc} (integration stopped at t={t:.6g}; last good state: {state})"
+
+
+def _event_values(events, model, t, y):
+    nq = model.nq
+    return np.array([float(e.condition(t, y[:nq], y[nq:])) for e in events])
+
+
+def _crossed(e, g_old, g_new):
+    if e.direction > 0:
+        return g_old < 0 <= g_new
+    if e.direction < 0:
+        return g_old > 0 >= g_new
+    return (g_old < 0 <= g_new) or (g_old > 0 >= g_new)
+
+
+def _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events, t_eval,
+                  progress):
+    model = rhs.model
+    solver_cls = ADAPTIVE[integrator]
+    failure = None
+    try:
+        solver = solver_cls(rhs, t0, y0, t_end, rtol=rtol, atol=atol, max_step=max_step)
+    except (NonFiniteError, SingularMassMatrixError) as exc:
+        raise SimulationError(_describe_failure(model, exc, t0, y0),
+                              Result(model, [t0], y0[None, :model.nq], y0[None, model.nq:],
+                                     [], {})) from exc
+    ts, ys = [t0], [y0.copy()]
+    if t_eval is not None:
+        t_eval = np.asarray(t_eval, dtype=float)
+        ts, ys = ([t0], [y0.copy()]) if t_eval.size and t_eval[0] == t0 else ([], [])
+        next_eval = 1 if ts else 0
+    g_old = _event_values(events, model, t0, y0) if events else None
+    found = []
+    steps = 0
+    while solver.status == "running":
+        t_prev, y_prev = solver.t, solver.y.copy()
+        try:
+            message = solver.step()
+        except (NonFiniteError, SingularMassMatrixError) as exc:
+            failure = _describe_failure(model, exc, t_prev, y_prev)
+            break
+        if solver.status == "failed":
+            failure = (f"integrator {integrator} failed at t={solver.t:.6g}: {message}. "
+                       "Loosen rtol/atol, or try an implicit method (Radau, BDF) if the "
+                       "model is stiff")
+            break
+        steps += 1
+        t_new, y_new = solver.t, solver.y
+        stop_at = None
+        if events:
+            g_new = _event_values(events, model, t_new, y_new)
+            dense = None
+            hits = []
+            for k, e in enumerate(events):
+                if _crossed(e, g_old[k], g_new[k]):
+                    dense = dense or solver.dense_output()
+                    nq = model.nq
+
+                    def g(tt, e=e):
+                        yy = dense(tt)
+                        return float(e.condition(tt, yy[:nq], yy[nq:]))
+                    te = optimize.brentq(g, t_prev, t_new, xtol=4 * np.finfo(float).eps,
+                                         rtol=4 * np.finfo(float).eps)
+                    hits.append((te, e))
+            for te, e in sorted(hits, key=lambda h: h[0]):
+                if stop_at is not None:
+                    break
+                found.append((e.name, te))
+                if e.terminal:
+                    stop_at = te
+            g_old = g_new
+        if t_eval is None:
+            if stop_at is not None:
+                ts.append(stop_at)
+                ys.append(solver.dense_output()(stop_at))
+            else:
+                ts.append(t_new)
+                ys.append(y_new.copy())
+        else:
+            t_hi = stop_at if stop_at is not None else t_new
+            sel = t_eval[next_eval:]
+            sel = sel[sel <= t_hi]
+            if sel.size:
+                dense = solver.dense_output()
+                for te in sel:
+                    ts.append(te)
+                    ys.append(dense(te))
+                next_eval += sel.size
+            if stop_at is not None and (not ts or ts[-1] != stop_at):
+                ts.append(stop_at)
+                ys.append(solver.dense_output()(stop_at))
+        if progress is not None:
+            progress(ts[-1] if ts else t_new)
+        if stop_at is not None:
+            break
+    info = {"steps": steps, "njev": getattr(solver, "njev", 0), "nlu": getattr(solver, "nlu", 0),
+            "solver_rhs_evaluations": solver.nfev}
+    if failure is not None:
+        info["failure"] = failure
+    if not ts:
+        ts, ys = [solver.t], [solver.y.copy()]
+    return np.array(ts), np.array(ys), found, info
+
+
+def _run_fixed(rhs, integrator, t0, t_end, y0, dt, events, t_eval, progress):
+    model = rhs.model
+    nq = model.nq
+    n_steps = int(np.ceil((t_end - t0) / dt - 1e-9))
+    ts = [t0]
+    ys = [y0.copy()]
+    y = y0.copy()
+    t = t0
+    g_old = _event_values(events, model, t, y) if events else None
+    found = []
+    failure = None
+    steps = 0
+    for k in range(n_steps):
+        h = min(dt, t_end - t)
+        try:
+            y_new = _fixed_step(rhs, integrator, t, y, h, nq)
+        except (NonFiniteError, SingularMassMatrixError) as exc:
+            failure = _describe_failure(model, exc, t, y)
+            break
+        model.normalize_quaternions(y_new[:nq])
+        if not np.all(np.isfinite(y_new)):
+            bad = [n for n, v in zip(model.coordinates + model.speeds, y_new) if not np.isfinite(v)]
+            failure = _describe_failure(model, NonFiniteError(
+                f"the state became non-finite in {', '.join(bad)}"), t, y)
+            break
+        t_new = t0 + (k + 1) * dt if k + 1 < n_steps else t_end
+        steps += 1
+        stop = False
+        if events:
+            g_new = _event_values(events, model, t_new, y_new)
+            hits = []
+            for j, e in enumerate(events):
+                if _crossed(e, g_old[j], g_new[j]):
+                    # linear interpolation between the two steps bracketing the crossing
+                    te = t + h * g_old[j] / (g_old[j] - g_new[j])
+                    hits.append((te, e))
+            for te, e in sorted(hits, key=lambda x: x[0]):
+                found.append((e.name, te))
+                if e.terminal:
+                    stop = True
+                    break
+            g_old = g_new
+        t, y = t_new, y_new
+        ts.append(t)
+        ys.append(y.copy())
+        if progress is not None:
+            progress(t)
+        if stop:
+            break
+    ts, ys = np.array(ts), np.array(ys)
+    if t_eval is not None:
+        t_eval = np.asarray(t_eval, dtype=float)
+        t_eval = t_eval[t_eval <= ts[-1]]
+        ys = np.array([np.interp(t_eval, ts, ys[:, c]) for c in range(ys.shape[1])]).T
+        ts = t_eval
+    info = {"steps": steps}
+    if failure is not None:
+        info["failure"] = failure
+    return ts, ys, found, info
+
+
+def _fixed_step(rhs, integrator, t, y, h, nq):
+    model = rhs.model
+    if integrator == "euler":
+        return y + h * rhs(t, y)
+    if integrator == "semi-implicit-euler":
+        q, u = y[:nq], y[nq:]
+        rhs.evaluations += 1
+        u_new = u + h * model.forward_dynamics(q, u, t, method=rhs.method)
+        q_new = q + h * model.coordinate_rates(q, u_new)
+        return np.concatenate([q_new, u_new])
+    k1 = rhs(t, y)
+    k2 = rhs(t + h / 2, y + h / 2 * k1)
+    k3 = rhs(t + h / 2, y + h / 2 * k2)
+    k4 = rhs(t + h, y + h * k3)
+    return y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
