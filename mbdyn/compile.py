@@ -103,10 +103,15 @@ class Model:
     fresh arrays.
     """
 
-    def __init__(self, name, bodies, joints, loads, gravity, warnings=()):
+    def __init__(self, name, bodies, joints, loads, gravity, warnings=(), parameters=None,
+                 gravity_symbolic=None):
         self.name = name
         self.warnings = tuple(warnings)
         self.gravity = np.array(gravity, dtype=float)
+        #: the element records in topological order (for the symbolic layer and reports)
+        self.elements = (tuple(bodies), tuple(joints), tuple(loads))
+        self.parameters = dict(parameters or {})
+        self.gravity_symbolic = gravity_symbolic
         self.frames = tuple(b.name for b in bodies)
         self.bodies = tuple(b.name for b in bodies if b.has_inertia)
         self.joints = tuple(j.name for j in joints)
@@ -199,6 +204,8 @@ class Model:
         self._load_functions = []         # (load name, target array row, callable)
         for k, ld in enumerate(loads):
             for target, val in ((self._load_force, ld.force), (self._load_moment, ld.moment)):
+                if isinstance(val, tuple):
+                    val = self._lambdify_load(ld.name, val)
                 if callable(val):
                     self._load_functions.append((ld.name, target[k], val))
                 else:
@@ -229,6 +236,25 @@ class Model:
                               self._load_moment, self._load_in_body)
         self._kin_out = (self._R, self._r, self._w, self._v, self._alpha, self._a,
                          self._JR, self._JT, self._F, self._N)
+
+    def _lambdify_load(self, name, exprs):
+        """A callable ``(t, q, u) -> 3 values`` from sympy expressions of ``t`` and the
+        coordinate and speed names."""
+        import sympy
+        names = ("t",) + self.coordinates + self.speeds
+        used = {s.name for e in exprs for s in e.free_symbols}
+        unknown = sorted(used - set(names))
+        if unknown:
+            raise ModelError(f"load {name!r}: its expression uses {', '.join(unknown)}, which "
+                             "are neither t nor coordinates or speeds of the model "
+                             f"({', '.join(names[1:])})")
+        args = [sympy.Symbol(n) for n in names]
+        renamed = [e.subs({s: sympy.Symbol(s.name) for s in e.free_symbols}) for e in exprs]
+        fn = sympy.lambdify(args, sympy.Matrix(renamed).T, "numpy")
+
+        def load(t, q, u):
+            return np.asarray(fn(t, *q, *u), dtype=float).reshape(3)
+        return load
 
     # ------------------------------------------------------------------ state helpers
     def __repr__(self):

@@ -22,6 +22,40 @@ t = sympy.Symbol("t", real=True)
 AXIS_NAMES = {"x": 0, "y": 1, "z": 2}
 
 
+def has_symbols(value):
+    """True if ``value`` (a number, sympy object or nested sequence) holds a sympy expression."""
+    if isinstance(value, sympy.Basic):
+        return not value.is_number
+    if isinstance(value, (list, tuple)) or (isinstance(value, np.ndarray) and value.dtype == object):
+        return any(has_symbols(v) for v in value)
+    return False
+
+
+def substitute(expr, parameters):
+    """``expr`` with every symbol named in ``parameters`` replaced by its value."""
+    if not isinstance(expr, sympy.Basic):
+        return expr
+    return expr.subs({s: parameters[s.name] for s in expr.free_symbols if s.name in parameters})
+
+
+def numeric(value, parameters, element, what):
+    """Evaluate ``value`` (numbers, sympy expressions of parameters, nested sequences) to
+    floats; unknown symbols are an error that names them."""
+    if isinstance(value, sympy.Basic):
+        v = substitute(value, parameters)
+        if v.free_symbols:
+            names = ", ".join(sorted(x.name for x in v.free_symbols))
+            raise ModelError(f"{element}: {what} uses {names}, which are not parameters of the "
+                             "system; add them to System(parameters={...}) or use numbers")
+        try:
+            return float(v)
+        except TypeError:
+            raise ModelError(f"{element}: {what} = {value} is not a real number") from None
+    if isinstance(value, (list, tuple)) or (isinstance(value, np.ndarray) and value.dtype == object):
+        return [numeric(v, parameters, element, what) for v in value]
+    return value
+
+
 def _vector3(value, what, element):
     try:
         arr = np.asarray(value, dtype=float).reshape(-1)
@@ -105,15 +139,26 @@ class Body:
     mass: float = 0.0
     com: np.ndarray = field(default_factory=lambda: np.zeros(3))
     inertia: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
+    symbolic: dict = field(default_factory=dict)
 
     @property
     def has_inertia(self):
         return self.mass > 0.0 or bool(np.any(self.inertia != 0.0))
 
 
-def make_body(name, mass=0.0, com=(0, 0, 0), inertia=None):
-    """Validate and build a ``Body``; see ``System.add_body``."""
+def make_body(name, mass=0.0, com=(0, 0, 0), inertia=None, parameters=None):
+    """Validate and build a ``Body``; see ``System.add_body``.
+
+    Values may be sympy expressions of ``parameters`` (``{name: value}``); the record keeps
+    them in ``symbolic`` for the symbolic layer and uses their values everywhere else.
+    """
     element = f"body {name!r}"
+    parameters = parameters or {}
+    raw = {"mass": mass, "com": com, "inertia": inertia}
+    symbolic = {k: v for k, v in raw.items() if has_symbols(v)}
+    mass = numeric(mass, parameters, element, "mass")
+    com = numeric(com, parameters, element, "com")
+    inertia = numeric(inertia, parameters, element, "inertia")
     try:
         mass = float(mass)
     except (TypeError, ValueError):
@@ -122,7 +167,7 @@ def make_body(name, mass=0.0, com=(0, 0, 0), inertia=None):
         raise ModelError(f"{element}: mass must be finite and >= 0, got {mass!r}")
     com = _vector3(com, "com", element)
     inertia = inertia_tensor(inertia, element)
-    return Body(name, mass, com, inertia)
+    return Body(name, mass, com, inertia, symbolic)
 
 
 def inertia_tensor(inertia, element):
@@ -170,7 +215,7 @@ class Drive:
     expression: sympy.Expr | None = None
 
 
-def make_drive(drive, element):
+def make_drive(drive, element, parameters=None):
     if drive is None:
         return None
     if isinstance(drive, Drive):
@@ -181,7 +226,8 @@ def make_drive(drive, element):
                              "callables (q(t), q'(t), q''(t))")
         return Drive(*drive)
     try:
-        expr = sympy.sympify(drive) if isinstance(drive, (int, float)) else drive
+        expr = sympy.Float(drive) if isinstance(drive, (int, float)) else drive
+        expr = substitute(expr, parameters or {})
         free = expr.free_symbols
     except AttributeError:
         raise ModelError(f"{element}: drive must be a sympy expression of mb.t or three "
@@ -190,8 +236,8 @@ def make_drive(drive, element):
     other = {s for s in free if s.name != "t"}
     if other:
         names = ", ".join(sorted(s.name for s in other))
-        raise ModelError(f"{element}: drive depends on symbols {names} besides t; substitute "
-                         "numbers for them (expr.subs(...)) before adding the joint")
+        raise ModelError(f"{element}: drive depends on symbols {names} besides t; make them "
+                         "parameters of the system or substitute numbers (expr.subs(...))")
     tsyms = [s for s in free if s.name == "t"]
     expr = expr.subs({s: t for s in tsyms})
     funcs = [sympy.lambdify(t, e, "math") for e in (expr, expr.diff(t), expr.diff(t, 2))]
@@ -215,6 +261,7 @@ class Joint:
     coordinates: tuple
     speeds: tuple
     drive: Drive | None
+    symbolic: dict = field(default_factory=dict)
 
     @property
     def code(self):
@@ -268,9 +315,21 @@ def _default_names(name, kind, coordinates, speeds, element):
 
 
 def make_joint(name, kind, parent, child, *, axis=None, position=(0, 0, 0), orientation=None,
-               sequence=None, coordinates=None, speeds=None, drive=None):
-    """Validate and build a ``Joint``; see ``System.add_joint``."""
+               sequence=None, coordinates=None, speeds=None, drive=None, parameters=None):
+    """Validate and build a ``Joint``; see ``System.add_joint``.  Numbers may be sympy
+    expressions of ``parameters`` (kept in ``symbolic``)."""
     element = f"joint {name!r}"
+    parameters = parameters or {}
+    raw = {"axis": axis, "position": position, "orientation": orientation}
+    symbolic = {k: v for k, v in raw.items() if has_symbols(v)}
+    if not isinstance(axis, str):
+        axis = numeric(axis, parameters, element, "axis")
+    position = numeric(position, parameters, element, "position")
+    if isinstance(orientation, (tuple, list)) and len(orientation) == 2 and \
+            isinstance(orientation[0], str):
+        orientation = (orientation[0], numeric(orientation[1], parameters, element, "orientation"))
+    else:
+        orientation = numeric(orientation, parameters, element, "orientation")
     if kind not in KIND_CODES:
         raise ModelError(f"{element}: unknown kind {kind!r}; use one of "
                          + ", ".join(repr(k) for k in KIND_CODES))
@@ -288,27 +347,37 @@ def make_joint(name, kind, parent, child, *, axis=None, position=(0, 0, 0), orie
     position = _vector3(position, "position", element)
     C = parse_orientation(orientation, element)
     qn, un = _default_names(name, kind, coordinates, speeds, element)
-    drv = make_drive(drive, element)
+    drv = make_drive(drive, element, parameters)
     if drv is not None and kind not in ("revolute", "prismatic"):
         raise ModelError(f"{element}: only a revolute or prismatic joint can be driven "
                          f"(this one is {kind})")
-    return Joint(name, kind, parent, child, axis, position, C, seq, qn, un, drv)
+    return Joint(name, kind, parent, child, axis, position, C, seq, qn, un, drv, symbolic)
 
 
 @dataclass(frozen=True)
 class Load:
-    """A force at a point of a body and/or a moment on it; constants or functions of
-    ``(t, q, u)`` returning three numbers, in world or body components."""
+    """A force at a point of a body and/or a moment on it, in world or body components.
+
+    ``force`` and ``moment`` are each a constant array, a callable ``(t, q, u) -> 3 values``,
+    or a tuple of three sympy expressions of ``t`` and the model's coordinate and speed
+    names (parameters already substituted), turned into a callable at compile.
+    """
     name: str
     body: str
     force: object
     moment: object
     point: np.ndarray
     in_body: bool
+    symbolic: dict = field(default_factory=dict)
 
 
-def make_load(name, body, force=None, moment=None, point=(0, 0, 0), frame="world"):
+def make_load(name, body, force=None, moment=None, point=(0, 0, 0), frame="world",
+              parameters=None):
     element = f"load {name!r}"
+    parameters = parameters or {}
+    raw = {"force": force, "moment": moment, "point": point}
+    symbolic = {k: v for k, v in raw.items() if not callable(v) and has_symbols(v)}
+    point = numeric(point, parameters, element, "point")
     if frame not in ("world", "body"):
         raise ModelError(f"{element}: frame must be 'world' or 'body', got {frame!r}")
     if force is None and moment is None:
@@ -319,7 +388,16 @@ def make_load(name, body, force=None, moment=None, point=(0, 0, 0), frame="world
             parts.append(np.zeros(3))
         elif callable(val):
             parts.append(val)
+        elif has_symbols(val):
+            exprs = tuple(substitute(v if isinstance(v, sympy.Basic) else sympy.Float(float(v)),
+                                     parameters) for v in val)
+            if len(exprs) != 3:
+                raise ModelError(f"{element}: {what} must have three components")
+            if all(not e.free_symbols for e in exprs):
+                parts.append(_vector3([float(e) for e in exprs], what, element))
+            else:
+                parts.append(exprs)
         else:
             parts.append(_vector3(val, what, element))
     point = _vector3(point, "point", element)
-    return Load(name, body, parts[0], parts[1], point, frame == "body")
+    return Load(name, body, parts[0], parts[1], point, frame == "body", symbolic)

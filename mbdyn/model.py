@@ -10,9 +10,11 @@ import warnings
 
 import networkx as nx
 import numpy as np
+import sympy
 
 from .compile import Model
-from .elements import inertia_tensor, make_body, make_joint, make_load
+from .elements import (has_symbols, inertia_tensor, make_body, make_joint, make_load,
+                       numeric)
 from .errors import ModelError, ModelWarning, SingularMassMatrixError
 
 GROUND = "ground"
@@ -22,11 +24,26 @@ class System:
     """A multibody system under construction.
 
     ``gravity`` is the gravitational acceleration vector in world components
-    (default ``(0, 0, -9.81)``).
+    (default ``(0, 0, -9.81)``).  ``parameters`` ``{name: value}`` declares named
+    parameters: any number given to the system may then be a sympy expression of them
+    (``m, l = s.symbols("m l")``), which the symbolic layer keeps and the numeric layers
+    evaluate.
     """
 
-    def __init__(self, name="system", gravity=(0.0, 0.0, -9.81)):
+    def __init__(self, name="system", gravity=(0.0, 0.0, -9.81), parameters=None):
         self.name = str(name)
+        self.parameters = {}
+        for pname, value in (parameters or {}).items():
+            if not isinstance(pname, str) or not pname.isidentifier():
+                raise ModelError(f"system {name!r}: parameter name {pname!r} must be an "
+                                 "identifier")
+            try:
+                self.parameters[pname] = float(value)
+            except (TypeError, ValueError):
+                raise ModelError(f"system {name!r}: parameter {pname!r} must be a number, "
+                                 f"got {value!r}") from None
+        self.gravity_symbolic = gravity if has_symbols(gravity) else None
+        gravity = numeric(gravity, self.parameters, f"system {name!r}", "gravity")
         g = np.asarray(gravity, dtype=float).reshape(-1)
         if g.shape != (3,) or not np.all(np.isfinite(g)):
             raise ModelError(f"system {name!r}: gravity must be three finite numbers, "
@@ -38,6 +55,16 @@ class System:
         self._loads = {}
 
     # ------------------------------------------------------------------ building
+    def symbols(self, names):
+        """sympy symbols of declared parameters: ``m, l = s.symbols("m l")``."""
+        names = names.replace(",", " ").split() if isinstance(names, str) else list(names)
+        missing = [n for n in names if n not in self.parameters]
+        if missing:
+            raise ModelError(f"system {self.name!r}: {', '.join(missing)} are not parameters; "
+                             f"declared: {', '.join(self.parameters) or '(none)'}")
+        syms = tuple(sympy.Symbol(n, real=True) for n in names)
+        return syms[0] if len(syms) == 1 else syms
+
     def _check_new_frame(self, name):
         if not isinstance(name, str) or not name:
             raise ModelError(f"frame name must be a non-empty string, got {name!r}")
@@ -51,7 +78,7 @@ class System:
         frame origin), ``inertia`` about the centre of mass in body axes -- ``None``/0 for a
         particle, three principal moments, or a 3x3 tensor (see ``mbdyn.inertia``)."""
         self._check_new_frame(name)
-        self.graph.add_node(name, body=make_body(name, mass, com, inertia))
+        self.graph.add_node(name, body=make_body(name, mass, com, inertia, self.parameters))
         return name
 
     def add_frame(self, name):
@@ -98,7 +125,7 @@ class System:
                              "must be a tree")
         joint = make_joint(name, kind, parent, child, axis=axis, position=position,
                            orientation=orientation, sequence=sequence, coordinates=coordinates,
-                           speeds=speeds, drive=drive)
+                           speeds=speeds, drive=drive, parameters=self.parameters)
         names_in_use = {c for j in self._joints.values() for c in j.coordinates + j.speeds}
         clash = names_in_use.intersection(joint.coordinates + joint.speeds)
         if clash:
@@ -121,7 +148,7 @@ class System:
             raise ModelError(f"load {name!r}: unknown body {body!r}; loads act on bodies "
                              f"added with add_body (known: "
                              f"{', '.join(n for n in self.graph if n != GROUND)})")
-        self._loads[name] = make_load(name, body, force, moment, point, frame)
+        self._loads[name] = make_load(name, body, force, moment, point, frame, self.parameters)
         return name
 
     # ------------------------------------------------------------------ inspection
@@ -165,7 +192,8 @@ class System:
                 inertia_tensor(b.inertia, f"body {b.name!r}")
         found = [str(w.message) for w in caught if issubclass(w.category, ModelWarning)]
         model = Model(self.name, bodies, joints, list(self._loads.values()), self.gravity,
-                      warnings=found)
+                      warnings=found, parameters=self.parameters,
+                      gravity_symbolic=self.gravity_symbolic)
         if check_inertia and model.nu:
             _check_inertia_of_every_dof(model)
         return model
