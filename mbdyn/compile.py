@@ -161,10 +161,13 @@ class Model:
         self._speed_index = {c: k for k, c in enumerate(speeds)}
         self._speed_joint = []            # joint name of each speed
         self._free_joint_slots = []       # (kind code, q start, nq, u start, nu)
+        self._euler_middle = []           # (joint, q index of middle angle, proper sequence?)
         qi = ui = 0
         for j in joints:
             if j.drive is None and j.nu:
                 self._free_joint_slots.append((j.code, qi, j.nq, ui, j.nu))
+                if j.kind == "euler":
+                    self._euler_middle.append((j.name, qi + 1, j.sequence[0] == j.sequence[2]))
                 self._speed_joint.extend([j.name] * j.nu)
                 qi += j.nq
                 ui += j.nu
@@ -566,10 +569,25 @@ class Model:
             V -= self._mass[i] * self.gravity @ k.r_com[i]
         return T, V
 
+    def euler_singularity(self, q):
+        """Distance of every Euler-angle joint from its singular configuration:
+        ``{joint: |sin(q1)|}`` for proper sequences (``ZXZ``...), ``|cos(q1)|`` for
+        Tait-Bryan ones (``XYZ``...).  At 0 the angle rates are undefined."""
+        out = {}
+        for name, k, proper in self._euler_middle:
+            out[name] = abs(np.sin(q[k])) if proper else abs(np.cos(q[k]))
+        return out
+
     def mass_matrix_condition(self, q, t=0.0):
-        """2-norm condition number of ``M(q)`` (inf when singular)."""
-        M = self.mass_matrix(q, t)
+        """2-norm condition number of ``M(q)`` (inf when singular) and the speeds that
+        dominate its weakest direction: ``(condition, [speed names])``."""
         if self.nu == 0:
-            return 1.0
-        ev = np.linalg.eigvalsh(M)
-        return float(ev[-1] / ev[0]) if ev[0] > 0 else float("inf")
+            return 1.0, []
+        try:
+            M = self.mass_matrix(q, t)
+        except NonFiniteError:
+            return float("inf"), []
+        ev, vec = np.linalg.eigh(M)
+        weak = [s for s, x in zip(self.speeds, np.abs(vec[:, 0])) if x > 0.3]
+        cond = float(ev[-1] / ev[0]) if ev[0] > 0 else float("inf")
+        return cond, weak

@@ -10,12 +10,14 @@ classic RK4; quaternions are projected back onto the unit sphere after every ste
 from __future__ import annotations
 
 import time as _time
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 from scipy import integrate, optimize
 
-from .errors import ModelError, NonFiniteError, SimulationError, SingularMassMatrixError
+from .errors import (ModelError, NonFiniteError, SimulationError, SingularityWarning,
+                     SingularMassMatrixError)
 
 ADAPTIVE = {"RK45": integrate.RK45, "RK23": integrate.RK23, "DOP853": integrate.DOP853,
             "Radau": integrate.Radau, "BDF": integrate.BDF, "LSODA": integrate.LSODA}
@@ -130,6 +132,63 @@ class Result:
         return self
 
 
+CONDITION_WARNING = 1e10      # warn when cond(M) exceeds this: ~10 digits are at stake
+SINGULARITY_WARNING = 1e-2    # warn when an Euler joint comes this close to its singularity
+
+
+class _Monitor:
+    """Watches accepted steps for Euler-angle joints approaching their singularity.
+
+    Warns once per joint below ``SINGULARITY_WARNING``; stops the run (a failure message)
+    below ``threshold`` or when a step crosses the singular configuration, before the angle
+    rates blow up.
+    """
+
+    def __init__(self, model, threshold):
+        self.model = model
+        self.threshold = threshold
+        self.warned = set()
+        self.closest = {}
+        self.last = {}
+
+    def check(self, t, y):
+        if not self.model._euler_middle:
+            return None
+        for joint, k, proper in self.model._euler_middle:
+            signed = np.sin(y[k]) if proper else np.cos(y[k])
+            dist = abs(signed)
+            previous = self.last.get(joint)
+            self.last[joint] = (t, signed)
+            self.closest[joint] = min(self.closest.get(joint, np.inf), dist)
+            crossed = previous is not None and previous[1] * signed < 0
+            if dist < self.threshold or crossed:
+                where = (f"between t={previous[0]:.6g} and t={t:.6g}" if crossed
+                         else f"at t={t:.6g} (distance {dist:.3g} < {self.threshold:g})")
+                return (f"joint {joint!r}: its Euler angles reached their singular "
+                        f"configuration {where}, where the angle rates are undefined and the "
+                        "equations of motion singular.  Model the joint as 'spherical' (unit "
+                        "quaternion), which has no singularity, or choose an Euler sequence "
+                        "whose singularity the motion avoids")
+            if dist < SINGULARITY_WARNING and joint not in self.warned:
+                self.warned.add(joint)
+                warnings.warn(f"joint {joint!r}: the Euler angles come close to their "
+                              f"singularity at t={t:.6g} (distance {dist:.3g}); accuracy and step "
+                              "size suffer -- a spherical (quaternion) joint avoids this",
+                              SingularityWarning, stacklevel=4)
+        return None
+
+
+def _conditioning(model, q, t, stats, key):
+    cond, weak = model.mass_matrix_condition(q, t)
+    stats[key] = cond
+    if cond > CONDITION_WARNING:
+        warnings.warn(f"model {model.name!r} at t={t:.6g}: the mass matrix is nearly singular "
+                      f"(condition number {cond:.3g}; about {np.log10(cond):.0f} of 16 digits "
+                      f"are lost); speeds {', '.join(weak)} carry almost no inertia.  Check "
+                      "the masses and inertias they move, or remove those degrees of freedom",
+                      SingularityWarning, stacklevel=3)
+
+
 class _RightHandSide:
     """``y = [q, u] -> [q', u']`` counting evaluations; NaN/Inf becomes an error."""
 
@@ -151,7 +210,7 @@ class _RightHandSide:
 
 def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator="RK45", rtol=1e-6,
              atol=1e-9, dt=None, method="jourdain", events=(), t_eval=None, max_step=np.inf,
-             outputs=(), points=None, progress=None):
+             outputs=(), points=None, progress=None, singularity_threshold=1e-3):
     """Integrate ``model`` from ``t0`` to ``t_end``.
 
     ``q0``/``u0``: arrays or ``{name: value}`` over the defaults (zero, identity
@@ -159,7 +218,12 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator="RK45", rtol=
     ``method``: ``"jourdain"`` or ``"newton-euler"``.  ``events``: ``Event``s.  ``t_eval``:
     output times (default every accepted step).  ``outputs``: any of ``"reactions"``,
     ``"energy"``; ``points``: ``{name: (frame, offset)}``.  ``progress``: optional callable
-    ``progress(t)`` called after each step.
+    ``progress(t)`` called after each step.  ``singularity_threshold``: stop when an
+    Euler-angle joint comes this close to its singularity (see ``Model.euler_singularity``).
+
+    Statistics include the mass matrix's condition number at the start and the end (a
+    ``SingularityWarning`` when it is large), the largest quaternion drift and, with
+    ``outputs=("energy",)``, the energy drift.
 
     Raises ``SimulationError`` (its ``result`` holds the motion up to the failure) when
     the integrator fails or NaN/Inf appears.
@@ -178,23 +242,34 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator="RK45", rtol=
     model.normalize_quaternions(q)
     events = [_as_event(e) for e in events]
     rhs = _RightHandSide(model, method)
+    monitor = _Monitor(model, singularity_threshold)
     y0 = np.concatenate([q, u])
+    failure = monitor.check(t0, y0)
+    if failure:
+        raise ModelError("the initial state is unusable: " + failure)
+    pre_stats = {}
+    _conditioning(model, q, t0, pre_stats, "mass_matrix_condition_initial")
+    if integrator not in ADAPTIVE and (dt is None or not dt > 0):
+        raise ModelError(f"integrator {integrator!r} is fixed-step: give dt > 0")
     start = _time.perf_counter()
     if integrator in ADAPTIVE:
         ts, ys, found, info = _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol,
-                                            max_step, events, t_eval, progress)
+                                            max_step, events, t_eval, progress, monitor)
     else:
-        if dt is None or not dt > 0:
-            raise ModelError(f"integrator {integrator!r} is fixed-step: give dt > 0")
         ts, ys, found, info = _run_fixed(rhs, integrator, t0, t_end, y0, float(dt), events,
-                                         t_eval, progress)
+                                         t_eval, progress, monitor)
     wall = _time.perf_counter() - start
     ys = np.asarray(ys).reshape(len(ts), -1)
     stats = {"integrator": integrator, "method": method, "rtol": rtol, "atol": atol, "dt": dt,
              "rhs_evaluations": rhs.evaluations, "wall_time_s": wall,
              "quaternion_drift": max((model.quaternion_drift(y[:model.nq]) for y in ys),
                                      default=0.0)}
+    stats.update(pre_stats)
     stats.update(info)
+    if monitor.closest:
+        stats["euler_singularity_distance"] = dict(monitor.closest)
+    if "failure" not in info:
+        _conditioning(model, ys[-1, :model.nq], ts[-1], stats, "mass_matrix_condition_final")
     failure = stats.pop("failure", None)
     qs = ys[:, :model.nq].copy()
     for row in qs:                      # report unit quaternions; the drift is in stats
@@ -230,7 +305,7 @@ def _crossed(e, g_old, g_new):
 
 
 def _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events, t_eval,
-                  progress):
+                  progress, monitor):
     model = rhs.model
     solver_cls = ADAPTIVE[integrator]
     failure = None
@@ -262,6 +337,9 @@ def _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events, 
             break
         steps += 1
         t_new, y_new = solver.t, solver.y
+        failure = monitor.check(t_new, y_new)
+        if failure:
+            break
         stop_at = None
         if events:
             g_new = _event_values(events, model, t_new, y_new)
@@ -318,7 +396,7 @@ def _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events, 
     return np.array(ts), np.array(ys), found, info
 
 
-def _run_fixed(rhs, integrator, t0, t_end, y0, dt, events, t_eval, progress):
+def _run_fixed(rhs, integrator, t0, t_end, y0, dt, events, t_eval, progress, monitor):
     model = rhs.model
     nq = model.nq
     n_steps = int(np.ceil((t_end - t0) / dt - 1e-9))
@@ -344,6 +422,9 @@ def _run_fixed(rhs, integrator, t0, t_end, y0, dt, events, t_eval, progress):
                 f"the state became non-finite in {', '.join(bad)}"), t, y)
             break
         t_new = t0 + (k + 1) * dt if k + 1 < n_steps else t_end
+        failure = monitor.check(t_new, y_new)
+        if failure:
+            break
         steps += 1
         stop = False
         if events:
