@@ -131,13 +131,13 @@ class Model:
         uoff = np.zeros(n, np.int64)
         ucol = -np.ones(n, np.int64)
         free_q, free_u, coords, speeds = [], [], [], []
-        self._driven = []                 # (joint, qfull index, drive)
+        self._driven = []                 # (joint, qfull index, ufull index, drive)
         self._quaternions = []            # slices of q holding a quaternion
         nqf = nuf = 0
         for i, j in enumerate(joints):
             qoff[i], uoff[i] = nqf, nuf
             if j.drive is not None:
-                self._driven.append((j.name, nqf, j.drive))
+                self._driven.append((j.name, nqf, nuf, j.drive))
             elif j.nu:
                 ucol[i] = len(free_u)
                 start = len(free_q)
@@ -287,7 +287,7 @@ class Model:
 
     @property
     def driven_joints(self):
-        return tuple(nm for nm, _, _ in self._driven)
+        return tuple(d[0] for d in self._driven)
 
     def default_coordinates(self):
         """Zero coordinates with identity quaternions."""
@@ -348,10 +348,10 @@ class Model:
         self._qfull[self._free_q] = q
         self._ufull[self._free_u] = u
         self._udfull[:] = 0.0
-        for name, k, drive in self._driven:
-            self._qfull[k] = drive.position(t)
-            self._ufull[k] = drive.velocity(t)
-            self._udfull[k] = drive.acceleration(t)
+        for name, kq, ku, drive in self._driven:
+            self._qfull[kq] = drive.position(t)
+            self._ufull[ku] = drive.velocity(t)
+            self._udfull[ku] = drive.acceleration(t)
         for name, row, fn in self._load_functions:
             val = np.asarray(fn(t, q, u), dtype=float).reshape(-1)
             if val.shape != (3,):
@@ -372,9 +372,9 @@ class Model:
             if not np.all(np.isfinite(row)):
                 raise NonFiniteError(f"model {self.name!r}, t={t:.6g}: load {name!r} returned "
                                      f"non-finite values {row.tolist()}")
-        for name, k, _ in self._driven:
-            if not (np.isfinite(self._qfull[k]) and np.isfinite(self._ufull[k])
-                    and np.isfinite(self._udfull[k])):
+        for name, kq, ku, _ in self._driven:
+            if not (np.isfinite(self._qfull[kq]) and np.isfinite(self._ufull[ku])
+                    and np.isfinite(self._udfull[ku])):
                 raise NonFiniteError(f"model {self.name!r}, t={t:.6g}: the drive of joint "
                                      f"{name!r} gave a non-finite value")
         bad = [n for n, x in zip(self.speeds, out) if not np.isfinite(x)]
@@ -537,7 +537,7 @@ class Model:
         (the reaction component along the joint axis, in the axis' sense)."""
         reac = self.reactions(q, u, t)
         out = {}
-        for name, _, _ in self._driven:
+        for name, *_ in self._driven:
             j = self._joint[name]
             i = self._frame_index[j.child]
             axis_world = self._R[i] @ j.axis
@@ -568,6 +568,34 @@ class Model:
             T += 0.5 * self._mass[i] * k.v_com[i] @ k.v_com[i] + 0.5 * k.w[i] @ Iw @ k.w[i]
             V -= self._mass[i] * self.gravity @ k.r_com[i]
         return T, V
+
+    # ------------------------------------------------------------------ compiled loops
+    @property
+    def has_callable_loads(self):
+        """True when some load is a Python function (compiled loops cannot call it)."""
+        return bool(self._load_functions)
+
+    def drive_values(self, times):
+        """``(len(times), n_drives, 3)``: each drive's ``q, q', q''`` at ``times``."""
+        out = np.empty((len(times), len(self._driven), 3))
+        for d, (_, _, _, drive) in enumerate(self._driven):
+            for k, tk in enumerate(times):
+                out[k, d] = drive.position(tk), drive.velocity(tk), drive.acceleration(tk)
+        return out
+
+    def loop_arguments(self):
+        """The arrays ``kernels.integrators.fixed_step_loop`` needs after its drive table:
+        ``(nq, slots, quats, free_q, free_u, drive_q, drive_u, tree, body, loads, ws)``."""
+        slots = np.array(self._free_joint_slots, np.int64).reshape(-1, 5)
+        quats = np.array([s.start for s in self._quaternions], np.int64)
+        drive_q = np.array([d[1] for d in self._driven], np.int64)
+        drive_u = np.array([d[2] for d in self._driven], np.int64)
+        body = (self._mass, self._com, self._inertia, self._has_inertia, self.gravity)
+        ws = (self._qfull, self._ufull, self._udfull, self._R, self._r, self._w, self._v,
+              self._alpha, self._a, self._JR, self._JT, self._F, self._N, self._M, self._f,
+              self._L)
+        return (self.nq, slots, quats, self._free_q, self._free_u, drive_q, drive_u,
+                self._tree, body, self._loads_arrays, ws)
 
     def euler_singularity(self, q):
         """Distance of every Euler-angle joint from its singular configuration:

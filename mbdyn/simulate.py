@@ -21,7 +21,7 @@ from .errors import (ModelError, NonFiniteError, SimulationError, SingularityWar
 
 ADAPTIVE = {"RK45": integrate.RK45, "RK23": integrate.RK23, "DOP853": integrate.DOP853,
             "Radau": integrate.Radau, "BDF": integrate.BDF, "LSODA": integrate.LSODA}
-FIXED_STEP = ("euler", "semi-implicit-euler", "rk4")
+FIXED_STEP = ("euler", "semi-implicit-euler", "rk4", "implicit-midpoint")
 INTEGRATORS = tuple(ADAPTIVE) + FIXED_STEP
 OUTPUTS = ("reactions", "energy")
 
@@ -210,7 +210,8 @@ class _RightHandSide:
 
 def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator="RK45", rtol=1e-6,
              atol=1e-9, dt=None, method="jourdain", events=(), t_eval=None, max_step=np.inf,
-             outputs=(), points=None, progress=None, singularity_threshold=1e-3):
+             outputs=(), points=None, progress=None, singularity_threshold=1e-3,
+             compiled_loop=True):
     """Integrate ``model`` from ``t0`` to ``t_end``.
 
     ``q0``/``u0``: arrays or ``{name: value}`` over the defaults (zero, identity
@@ -220,6 +221,8 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator="RK45", rtol=
     ``"energy"``; ``points``: ``{name: (frame, offset)}``.  ``progress``: optional callable
     ``progress(t)`` called after each step.  ``singularity_threshold``: stop when an
     Euler-angle joint comes this close to its singularity (see ``Model.euler_singularity``).
+    ``compiled_loop``: run fixed-step schemes in compiled stretches when the model allows
+    (``method="jourdain"`` and no Python-function loads); ``False`` forces the Python loop.
 
     Statistics include the mass matrix's condition number at the start and the end (a
     ``SingularityWarning`` when it is large), the largest quaternion drift and, with
@@ -256,8 +259,9 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator="RK45", rtol=
         ts, ys, found, info = _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol,
                                             max_step, events, t_eval, progress, monitor)
     else:
+        compiled = compiled_loop and method == "jourdain" and not model.has_callable_loads
         ts, ys, found, info = _run_fixed(rhs, integrator, t0, t_end, y0, float(dt), events,
-                                         t_eval, progress, monitor)
+                                         t_eval, progress, monitor, compiled)
     wall = _time.perf_counter() - start
     ys = np.asarray(ys).reshape(len(ts), -1)
     stats = {"integrator": integrator, "method": method, "rtol": rtol, "atol": atol, "dt": dt,
@@ -396,57 +400,115 @@ def _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events, 
     return np.array(ts), np.array(ys), found, info
 
 
-def _run_fixed(rhs, integrator, t0, t_end, y0, dt, events, t_eval, progress, monitor):
+def _fixed_chunks(rhs, integrator, t0, t_end, y0, dt, compiled):
+    """Yield ``(times, states, failure)`` stretches of the fixed-step motion after ``y0``.
+
+    Compiled path (``kernels.integrators``) when ``compiled``; else one Python step at a
+    time.  Steps are of size ``dt``, the last one shortened to end at ``t_end``.
+    """
     model = rhs.model
-    nq = model.nq
-    n_steps = int(np.ceil((t_end - t0) / dt - 1e-9))
-    ts = [t0]
-    ys = [y0.copy()]
+    n_full = int(np.floor((t_end - t0) / dt * (1 + 1e-12)))
+    times = t0 + dt * np.arange(1, n_full + 1)
+    if n_full and times[-1] > t_end:
+        times[-1] = t_end
+    plan = [(dt, times)]
+    if t_end - (times[-1] if n_full else t0) > 1e-12 * max(1.0, abs(t_end)):
+        plan.append((t_end - (times[-1] if n_full else t0), np.array([t_end])))
     y = y0.copy()
     t = t0
+    if compiled:
+        from .kernels.integrators import SCHEMES, STAGES, fixed_step_loop
+        args = model.loop_arguments()
+        chunk = 2000
+        for h, ts in plan:
+            for lo in range(0, len(ts), chunk):
+                tk = ts[lo:lo + chunk]
+                starts = np.concatenate([[t], tk[:-1]])
+                stage_times = (starts[:, None] + h * np.array(STAGES)[None, :]).reshape(-1)
+                table = model.drive_values(stage_times).reshape(len(tk), len(STAGES), -1, 3)
+                out = np.empty((len(tk) + 1, y.size))
+                nfev = np.zeros(1, np.int64)
+                done, status = fixed_step_loop(SCHEMES[integrator], h, y, table, *args, out,
+                                               nfev)
+                rhs.evaluations += int(nfev[0])
+                failure = None
+                if status:
+                    t_fail = tk[done - 1] if done else t
+                    failure = _describe_failure(model, _LOOP_STATUS[status](model), t_fail,
+                                                out[done])
+                yield tk[:done], out[1:done + 1], failure
+                if status:
+                    return
+                t, y = tk[-1], out[-1].copy()
+        return
+    for h, ts in plan:
+        for t_new in ts:
+            try:
+                y_new = _fixed_step(rhs, integrator, t, y, h, model.nq)
+            except (NonFiniteError, SingularMassMatrixError) as exc:
+                yield np.empty(0), np.empty((0, y.size)), _describe_failure(model, exc, t, y)
+                return
+            model.normalize_quaternions(y_new[:model.nq])
+            if not np.all(np.isfinite(y_new)):
+                bad = [n for n, v in zip(model.coordinates + model.speeds, y_new)
+                       if not np.isfinite(v)]
+                yield np.empty(0), np.empty((0, y.size)), _describe_failure(
+                    model, NonFiniteError(f"the state became non-finite in {', '.join(bad)}"),
+                    t, y)
+                return
+            yield np.array([t_new]), y_new[None, :], None
+            t, y = t_new, y_new
+
+
+_LOOP_STATUS = {
+    1: lambda m: NonFiniteError("NaN or Inf appeared in the state or the accelerations"),
+    2: lambda m: SingularMassMatrixError("the mass matrix is not positive definite"),
+    3: lambda m: NonFiniteError("the implicit midpoint's Newton iteration did not converge; "
+                                "reduce dt"),
+}
+
+
+def _run_fixed(rhs, integrator, t0, t_end, y0, dt, events, t_eval, progress, monitor,
+               compiled):
+    model = rhs.model
+    ts = [t0]
+    ys = [y0.copy()]
+    t, y = t0, y0
     g_old = _event_values(events, model, t, y) if events else None
     found = []
     failure = None
     steps = 0
-    for k in range(n_steps):
-        h = min(dt, t_end - t)
-        try:
-            y_new = _fixed_step(rhs, integrator, t, y, h, nq)
-        except (NonFiniteError, SingularMassMatrixError) as exc:
-            failure = _describe_failure(model, exc, t, y)
-            break
-        model.normalize_quaternions(y_new[:nq])
-        if not np.all(np.isfinite(y_new)):
-            bad = [n for n, v in zip(model.coordinates + model.speeds, y_new) if not np.isfinite(v)]
-            failure = _describe_failure(model, NonFiniteError(
-                f"the state became non-finite in {', '.join(bad)}"), t, y)
-            break
-        t_new = t0 + (k + 1) * dt if k + 1 < n_steps else t_end
-        failure = monitor.check(t_new, y_new)
-        if failure:
-            break
-        steps += 1
-        stop = False
-        if events:
-            g_new = _event_values(events, model, t_new, y_new)
-            hits = []
-            for j, e in enumerate(events):
-                if _crossed(e, g_old[j], g_new[j]):
-                    # linear interpolation between the two steps bracketing the crossing
-                    te = t + h * g_old[j] / (g_old[j] - g_new[j])
-                    hits.append((te, e))
-            for te, e in sorted(hits, key=lambda x: x[0]):
-                found.append((e.name, te))
-                if e.terminal:
-                    stop = True
-                    break
-            g_old = g_new
-        t, y = t_new, y_new
-        ts.append(t)
-        ys.append(y.copy())
+    stop = False
+    for times, states, chunk_failure in _fixed_chunks(rhs, integrator, t0, t_end, y0, dt,
+                                                      compiled):
+        for t_new, y_new in zip(times, states):
+            failure = monitor.check(t_new, y_new)
+            if failure:
+                break
+            steps += 1
+            if events:
+                g_new = _event_values(events, model, t_new, y_new)
+                hits = []
+                for j, e in enumerate(events):
+                    if _crossed(e, g_old[j], g_new[j]):
+                        # linear interpolation between the two steps bracketing the crossing
+                        te = t + (t_new - t) * g_old[j] / (g_old[j] - g_new[j])
+                        hits.append((te, e))
+                for te, e in sorted(hits, key=lambda x: x[0]):
+                    found.append((e.name, te))
+                    if e.terminal:
+                        stop = True
+                        break
+                g_old = g_new
+            t, y = t_new, y_new
+            ts.append(t)
+            ys.append(y)
+            if stop:
+                break
         if progress is not None:
             progress(t)
-        if stop:
+        failure = failure or chunk_failure
+        if failure or stop:
             break
     ts, ys = np.array(ts), np.array(ys)
     if t_eval is not None:
@@ -454,13 +516,14 @@ def _run_fixed(rhs, integrator, t0, t_end, y0, dt, events, t_eval, progress, mon
         t_eval = t_eval[t_eval <= ts[-1]]
         ys = np.array([np.interp(t_eval, ts, ys[:, c]) for c in range(ys.shape[1])]).T
         ts = t_eval
-    info = {"steps": steps}
+    info = {"steps": steps, "compiled_loop": bool(compiled)}
     if failure is not None:
         info["failure"] = failure
     return ts, ys, found, info
 
 
 def _fixed_step(rhs, integrator, t, y, h, nq):
+    """One step of a fixed-step scheme in Python (models with callable loads)."""
     model = rhs.model
     if integrator == "euler":
         return y + h * rhs(t, y)
@@ -470,8 +533,34 @@ def _fixed_step(rhs, integrator, t, y, h, nq):
         u_new = u + h * model.forward_dynamics(q, u, t, method=rhs.method)
         q_new = q + h * model.coordinate_rates(q, u_new)
         return np.concatenate([q_new, u_new])
+    if integrator == "implicit-midpoint":
+        return _implicit_midpoint(rhs, t, y, h)
     k1 = rhs(t, y)
     k2 = rhs(t + h / 2, y + h / 2 * k1)
     k3 = rhs(t + h / 2, y + h / 2 * k2)
     k4 = rhs(t + h, y + h * k3)
     return y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+
+
+def _implicit_midpoint(rhs, t, y, h):
+    """``y1 = y + h F(t + h/2, (y + y1)/2)`` by Newton with a finite-difference Jacobian
+    (the same algorithm as the compiled ``implicit_midpoint_step``)."""
+    tm = t + h / 2
+    ym = y + h / 2 * rhs(t, y)
+    fm = rhs(tm, ym)
+    y1 = y + h * fm
+    n = y.size
+    J = np.eye(n)
+    for j in range(n):
+        eps = 1.4901161193847656e-08 * max(1.0, abs(ym[j]))
+        yp = ym.copy()
+        yp[j] += eps
+        J[:, j] -= 0.5 * h * (rhs(tm, yp) - fm) / eps
+    for _ in range(30):
+        G = y1 - y - h * rhs(tm, 0.5 * (y + y1))
+        dy = np.linalg.solve(J, G)
+        y1 = y1 - dy
+        if np.abs(dy).max() <= 1e-14 * max(1.0, np.abs(y1).max()):
+            return y1
+    raise NonFiniteError("the implicit midpoint's Newton iteration did not converge; "
+                         "reduce dt")

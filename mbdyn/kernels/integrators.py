@@ -1,0 +1,201 @@
+"""Compiled fixed-step integration loops over the Jourdain right-hand side.
+
+A Python loop spends most of a small model's step in interpreter overhead; these loops run
+whole stretches of steps in one compiled call.  They serve models whose loads are
+constants (callable loads need Python) -- drives are allowed, their values being
+precomputed at every stage time by the caller.
+
+Schemes (codes): 0 explicit Euler, 1 semi-implicit (symplectic) Euler -- velocities first,
+then positions with the new velocities, the textbook's scheme --, 2 classic RK4,
+3 implicit midpoint (symmetric, preserves quadratic invariants such as a quaternion's norm;
+solved by Newton's method with a finite-difference Jacobian).  Quaternions are projected
+onto the unit sphere after every step.
+
+Status codes returned: 0 done, 1 non-finite state or acceleration, 2 mass matrix not
+positive definite, 3 implicit midpoint's Newton iteration did not converge.
+"""
+import numpy as np
+from numba import njit
+
+from .evaluate import jourdain_accelerations
+from .joints import joint_coordinate_rates
+
+EULER, SEMI_IMPLICIT_EULER, RK4, IMPLICIT_MIDPOINT = 0, 1, 2, 3
+SCHEMES = {"euler": EULER, "semi-implicit-euler": SEMI_IMPLICIT_EULER, "rk4": RK4,
+           "implicit-midpoint": IMPLICIT_MIDPOINT}
+# stage times of each scheme as fractions of the step (drives are evaluated there)
+STAGES = (0.0, 0.5, 1.0)
+
+
+@njit(cache=True)
+def _rates(y, nq, slots, out):
+    """``q' = N(q) u`` into ``out[:nq]``."""
+    for s in range(slots.shape[0]):
+        code, qi, nqj, ui, nuj = slots[s, 0], slots[s, 1], slots[s, 2], slots[s, 3], slots[s, 4]
+        joint_coordinate_rates(code, y[qi:qi + nqj], y[nq + ui:nq + ui + nuj],
+                               out[qi:qi + nqj])
+
+
+@njit(cache=True)
+def _rhs(y, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads, ws,
+         ydot, nfev):
+    """``ydot = [N(q) u, M^-1 f]`` at the stage whose drive values are ``drive_vals``;
+    counts the evaluation in ``nfev[0]``."""
+    nfev[0] += 1
+    (parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx) = tree
+    (mass, com, inertia, has_inertia, gravity) = body
+    (load_body, load_point, load_force, load_moment, load_in_body) = loads
+    (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, F, N, M, f, L) = ws
+    nu = y.shape[0] - nq
+    for k in range(nq):
+        qfull[free_q[k]] = y[k]
+    for k in range(nu):
+        ufull[free_u[k]] = y[nq + k]
+        udfull[free_u[k]] = 0.0
+    for d in range(drive_q.shape[0]):
+        qfull[drive_q[d]] = drive_vals[d, 0]
+        ufull[drive_u[d]] = drive_vals[d, 1]
+        udfull[drive_u[d]] = drive_vals[d, 2]
+    ud = ydot[nq:]
+    pivot = jourdain_accelerations(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr,
+                                   anc_idx, mass, com, inertia, has_inertia, gravity, qfull,
+                                   ufull, udfull, load_body, load_point, load_force, load_moment,
+                                   load_in_body, R, r, w, v, alpha, a, JR, JT, F, N, M, f, L, ud)
+    if pivot >= 0:
+        return 2
+    _rates(y, nq, slots, ydot)
+    for k in range(ydot.shape[0]):
+        if not np.isfinite(ydot[k]):
+            return 1
+    return 0
+
+
+@njit(cache=True)
+def _normalize(y, quats):
+    for s in range(quats.shape[0]):
+        i = quats[s]
+        n = np.sqrt(y[i] ** 2 + y[i + 1] ** 2 + y[i + 2] ** 2 + y[i + 3] ** 2)
+        for k in range(4):
+            y[i + k] /= n
+
+
+@njit(cache=True)
+def fixed_step_loop(scheme, h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q,
+                    drive_u, tree, body, loads, ws, out, nfev):
+    """Run ``out.shape[0] - 1`` steps of size ``h`` from ``y0``; ``out[k]`` is the state
+    after k steps.  ``drive_table[k, s]`` holds the drives' ``(q, q', q'')`` at stage time
+    ``t_k + STAGES[s] h``; ``nfev[0]`` counts right-hand-side evaluations.
+    Returns ``(steps done, status)``."""
+    ny = y0.shape[0]
+    n_steps = out.shape[0] - 1
+    out[0] = y0
+    k1 = np.empty(ny)
+    k2 = np.empty(ny)
+    k3 = np.empty(ny)
+    k4 = np.empty(ny)
+    tmp = np.empty(ny)
+    J = np.empty((ny, ny))
+    for n in range(n_steps):
+        y = out[n]
+        yn = out[n + 1]
+        if scheme == EULER:
+            st = _rhs(y, drive_table[n, 0], nq, slots, free_q, free_u, drive_q, drive_u, tree,
+                      body, loads, ws, k1, nfev)
+            if st:
+                return n, st
+            for i in range(ny):
+                yn[i] = y[i] + h * k1[i]
+        elif scheme == SEMI_IMPLICIT_EULER:
+            st = _rhs(y, drive_table[n, 0], nq, slots, free_q, free_u, drive_q, drive_u, tree,
+                      body, loads, ws, k1, nfev)
+            if st:
+                return n, st
+            for i in range(nq, ny):
+                yn[i] = y[i] + h * k1[i]           # velocities first
+            for i in range(nq):
+                tmp[i] = y[i]
+            for i in range(nq, ny):
+                tmp[i] = yn[i]
+            _rates(tmp, nq, slots, k2)              # positions with the new velocities
+            for i in range(nq):
+                yn[i] = y[i] + h * k2[i]
+        elif scheme == RK4:
+            st = _rhs(y, drive_table[n, 0], nq, slots, free_q, free_u, drive_q, drive_u, tree,
+                      body, loads, ws, k1, nfev)
+            for i in range(ny):
+                tmp[i] = y[i] + 0.5 * h * k1[i]
+            st = st or _rhs(tmp, drive_table[n, 1], nq, slots, free_q, free_u, drive_q,
+                            drive_u, tree, body, loads, ws, k2, nfev)
+            for i in range(ny):
+                tmp[i] = y[i] + 0.5 * h * k2[i]
+            st = st or _rhs(tmp, drive_table[n, 1], nq, slots, free_q, free_u, drive_q,
+                            drive_u, tree, body, loads, ws, k3, nfev)
+            for i in range(ny):
+                tmp[i] = y[i] + h * k3[i]
+            st = st or _rhs(tmp, drive_table[n, 2], nq, slots, free_q, free_u, drive_q,
+                            drive_u, tree, body, loads, ws, k4, nfev)
+            if st:
+                return n, st
+            for i in range(ny):
+                yn[i] = y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+        else:
+            st = implicit_midpoint_step(y, h, drive_table[n, 1], nq, slots, free_q, free_u,
+                                        drive_q, drive_u, tree, body, loads, ws, yn, k1, k2,
+                                        tmp, J, nfev)
+            if st:
+                return n, st
+        _normalize(yn, quats)
+    return n_steps, 0
+
+
+@njit(cache=True)
+def implicit_midpoint_step(y, h, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u,
+                           tree, body, loads, ws, yn, fm, fp, ym, J, nfev):
+    """``yn = y + h F((y + yn)/2)`` by Newton's method; the Jacobian of F by forward
+    differences at the explicit predictor's midpoint, kept for the step's iterations."""
+    ny = y.shape[0]
+    st = _rhs(y, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads,
+              ws, fm, nfev)
+    if st:
+        return st
+    for i in range(ny):
+        ym[i] = y[i] + 0.5 * h * fm[i]
+    st = _rhs(ym, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads,
+              ws, fm, nfev)
+    if st:
+        return st
+    for i in range(ny):
+        yn[i] = y[i] + h * fm[i]                    # predictor: explicit midpoint
+    # J = I - h/2 dF/dy at the predictor's midpoint
+    for j in range(ny):
+        eps = 1.4901161193847656e-08 * max(1.0, abs(ym[j]))
+        old = ym[j]
+        ym[j] = old + eps
+        st = _rhs(ym, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body,
+                  loads, ws, fp, nfev)
+        ym[j] = old
+        if st:
+            return st
+        for i in range(ny):
+            J[i, j] = -0.5 * h * (fp[i] - fm[i]) / eps
+        J[j, j] += 1.0
+    G = np.empty(ny)
+    for it in range(30):
+        for i in range(ny):
+            ym[i] = 0.5 * (y[i] + yn[i])
+        st = _rhs(ym, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body,
+                  loads, ws, fm, nfev)
+        if st:
+            return st
+        for i in range(ny):
+            G[i] = yn[i] - y[i] - h * fm[i]
+        dy = np.linalg.solve(J, G)
+        size = 0.0
+        scale = 0.0
+        for i in range(ny):
+            yn[i] -= dy[i]
+            size = max(size, abs(dy[i]))
+            scale = max(scale, abs(yn[i]))
+        if size <= 1e-14 * max(1.0, scale):
+            return 0
+    return 3
