@@ -486,10 +486,9 @@ class Model:
             names = [s for s, wgt in zip(self.speeds, weight) if wgt > 0.1]
         else:
             names = [self.speeds[pivot]] if pivot is not None else []
-        joints = sorted({self._speed_joint[self._speed_index[s]] for s in names})
         raise SingularMassMatrixError(
             f"model {self.name!r}, t={t:.6g}: the mass matrix is not positive definite; "
-            f"speeds {', '.join(names)} (joints {', '.join(joints)}) carry no inertia here "
+            f"the degrees of freedom {self.describe_speeds(names)} carry no inertia here "
             "(smallest eigenvalue {:.3g}, largest {:.3g}).  Give the bodies they move mass "
             "or inertia, or, for a configuration singularity such as Euler angles at "
             "sin(theta)=0, use a spherical (quaternion) joint.".format(eigval[0], eigval[-1]),
@@ -513,24 +512,33 @@ class Model:
             out[name] = (force, moment)
         return out
 
-    def reactions(self, q, u, t=0.0, method="newton-euler"):
+    def reactions(self, q, u, t=0.0, method="newton-euler", frame="world"):
         """Force and moment each joint's parent exerts on its child, reduced to the joint
-        origin (the child frame's origin), world components: ``{joint: (F[3], M[3])}``.
+        origin (the child frame's origin): ``{joint: (F[3], M[3])}``, in world components
+        (``frame="world"``) or in the child frame's own components (``frame="child"``, as
+        the textbook writes reactions).
 
         ``method="newton-euler"`` solves the system with reaction unknowns;
         ``"jourdain"`` computes the accelerations from ``M u' = f`` and then the joint
         wrenches by inverse dynamics from the leaves to the root.
         """
+        if frame not in ("world", "child"):
+            raise ModelError(f"unknown frame {frame!r} for reactions; use 'world' or 'child'")
         if method == "newton-euler":
-            return self.newton_euler(q, u, t)[1]
-        if method != "jourdain":
+            out = self.newton_euler(q, u, t)[1]
+        elif method == "jourdain":
+            ud = self.forward_dynamics(q, u, t)
+            self._kinematics_kernel(q, u, t, ud)
+            w = np.empty((self.n_frames, 6))
+            kd.joint_wrenches(self._mass, self._com, self._inertia, self._parent, self._R,
+                              self._r, self._w, self._alpha, self._a, self._F, self._N, w)
+            out = {name: (w[i, :3].copy(), w[i, 3:].copy()) for i, name in enumerate(self.joints)}
+        else:
             raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")
-        ud = self.forward_dynamics(q, u, t)
-        self._kinematics_kernel(q, u, t, ud)
-        out = np.empty((self.n_frames, 6))
-        kd.joint_wrenches(self._mass, self._com, self._inertia, self._parent, self._R, self._r,
-                          self._w, self._alpha, self._a, self._F, self._N, out)
-        return {name: (out[i, :3].copy(), out[i, 3:].copy()) for i, name in enumerate(self.joints)}
+        if frame == "child":
+            out = {name: (self._R[i].T @ f, self._R[i].T @ m)
+                   for i, (name, (f, m)) in enumerate(out.items())}
+        return out
 
     def drive_efforts(self, q, u, t=0.0):
         """Force or torque each driven joint needs to impose its motion: ``{joint: value}``
@@ -596,6 +604,20 @@ class Model:
               self._L)
         return (self.nq, slots, quats, self._free_q, self._free_u, drive_q, drive_u,
                 self._tree, body, self._loads_arrays, ws)
+
+    def describe_speeds(self, speeds):
+        """``"theta2 (joint 'theta2')"``: the coordinates and joints behind some speeds
+        (for a joint whose speeds are not coordinate rates, the speeds are named too)."""
+        parts = []
+        for j in dict.fromkeys(self._speed_joint[self._speed_index[s]] for s in speeds):
+            joint = self._joint[j]
+            mine = [x for x in speeds if self._speed_joint[self._speed_index[x]] == j]
+            if joint.kind in ("spherical", "free"):
+                parts.append(f"{', '.join(mine)} (joint {j!r})")
+            else:
+                coords = [joint.coordinates[joint.speeds.index(x)] for x in mine]
+                parts.append(f"{', '.join(coords)} (joint {j!r})")
+        return "; ".join(parts) or "some coordinates"
 
     def euler_singularity(self, q):
         """Distance of every Euler-angle joint from its singular configuration:

@@ -218,8 +218,7 @@ def _check_inertia_of_every_dof(model, samples=3, seed=12345):
             singular_sets.append(set(exc.coordinates))
     names = sorted(set.intersection(*singular_sets), key=model.speeds.index) or \
         sorted(set.union(*singular_sets), key=model.speeds.index)
-    joints = sorted({model._speed_joint[model.speed_index(s)] for s in names})
-    raise ModelError(f"system {model.name!r}: degrees of freedom {', '.join(names)} (joints "
-                     f"{', '.join(joints)}) carry no inertia -- the mass matrix is singular in "
-                     "every configuration.  Give the bodies these joints move mass or inertia "
-                     "about the joint axes, or remove (fix) those joints.")
+    raise ModelError(f"system {model.name!r}: the degrees of freedom {model.describe_speeds(names)} "
+                     "carry no inertia -- the mass matrix is singular in every configuration.  "
+                     "Give the bodies these joints move mass or inertia about the joint axes, "
+                     "or remove (fix) those joints.")
