@@ -146,7 +146,7 @@ class System:
             raise ModelError(f"load {name!r}: the name is already used by another load")
         if body not in self.graph or body == GROUND:
             raise ModelError(f"load {name!r}: unknown body {body!r}; loads act on bodies "
-                             f"added with add_body (known: "
+                             f"and frames added with add_body or add_frame (known: "
                              f"{', '.join(n for n in self.graph if n != GROUND)})")
         self._loads[name] = make_load(name, body, force, moment, point, frame, self.parameters)
         return name

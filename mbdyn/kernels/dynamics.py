@@ -9,6 +9,7 @@ import numpy as np
 from numba import njit
 
 from .kinematics import cross
+from .linalg3 import cross_to, mat_vec, rotate_tensor
 
 
 @njit(cache=True)
@@ -20,6 +21,11 @@ def applied_loads(mass, com, gravity, R, r, load_body, load_point, load_force, l
     its force and moment are given in body (1) or world (0) components.
     """
     n = mass.shape[0]
+    f = np.empty(3)
+    mo = np.empty(3)
+    arm = np.empty(3)
+    lever = np.empty(3)
+    t = np.empty(3)
     for i in range(n):
         for k in range(3):
             F[i, k] = mass[i] * gravity[k]
@@ -27,28 +33,40 @@ def applied_loads(mass, com, gravity, R, r, load_body, load_point, load_force, l
     for m in range(load_body.shape[0]):
         i = load_body[m]
         if load_in_body[m]:
-            f = R[i] @ load_force[m]
-            mo = R[i] @ load_moment[m]
+            mat_vec(R[i], load_force[m], f)
+            mat_vec(R[i], load_moment[m], mo)
         else:
-            f = load_force[m].copy()
-            mo = load_moment[m].copy()
-        lever = R[i] @ (load_point[m] - com[i])      # centre of mass -> point of action
-        mo += cross(lever, f)
+            f[:] = load_force[m]
+            mo[:] = load_moment[m]
+        for k in range(3):
+            arm[k] = load_point[m, k] - com[i, k]
+        mat_vec(R[i], arm, lever)                    # centre of mass -> point of action
+        cross_to(lever, f, t)
         for k in range(3):
             F[i, k] += f[k]
-            N[i, k] += mo[k]
+            N[i, k] += mo[k] + t[k]
 
 
 @njit(cache=True)
-def body_terms(i, mass, com, inertia, R, w, alpha_b, a_b):
-    """Per body: lever ``c`` (origin -> centre of mass), world inertia ``Iw``, bias
-    acceleration of the centre of mass and the inertia moment ``Iw alpha_b + w x Iw w``."""
-    c = R[i] @ com[i]
-    Iw = R[i] @ inertia[i] @ R[i].T
+def body_terms(i, com, inertia, R, w, alpha_b, a_b, c, Iw, aG_b, gyro, S3, t1, t2):
+    """Per body i, into the given arrays: lever ``c`` (origin -> centre of mass), world
+    inertia ``Iw``, bias acceleration of the centre of mass ``aG_b`` and the inertia
+    moment ``gyro = Iw alpha_b + w x Iw w``.  ``S3``, ``t1``, ``t2`` are scratch."""
+    mat_vec(R[i], com[i], c)
+    rotate_tensor(R[i], inertia[i], S3, Iw)
     wi = w[i]
-    aG_b = a_b[i] + cross(alpha_b[i], c) + cross(wi, cross(wi, c))
-    gyro = Iw @ alpha_b[i] + cross(wi, Iw @ wi)
-    return c, Iw, aG_b, gyro
+    cross_to(alpha_b[i], c, t1)
+    for k in range(3):
+        aG_b[k] = a_b[i, k] + t1[k]
+    cross_to(wi, c, t1)
+    cross_to(wi, t1, t2)
+    for k in range(3):
+        aG_b[k] += t2[k]
+    mat_vec(Iw, wi, t1)
+    cross_to(wi, t1, t2)
+    mat_vec(Iw, alpha_b[i], t1)
+    for k in range(3):
+        gyro[k] = t1[k] + t2[k]
 
 
 @njit(cache=True)
@@ -71,14 +89,28 @@ def jourdain(mass, com, inertia, has_inertia, R, w, alpha_b, a_b, JR, JT, anc_pt
     f[:] = 0.0
     JG = np.zeros((3, nu))
     IJ = np.zeros((3, nu))
+    c = np.empty(3)
+    Iw = np.empty((3, 3))
+    S3 = np.empty((3, 3))
+    aG_b = np.empty(3)
+    gyro = np.empty(3)
+    t1 = np.empty(3)
+    t2 = np.empty(3)
+    fT = np.empty(3)
+    fR = np.empty(3)
     for i in range(mass.shape[0]):
         if not has_inertia[i]:
-            continue
+            loaded = False
+            for k in range(3):
+                loaded = loaded or F[i, k] != 0.0 or N[i, k] != 0.0
+            if not loaded:               # a massless frame without loads adds nothing
+                continue
         m_i = mass[i]
-        c, Iw, aG_b, gyro = body_terms(i, mass, com, inertia, R, w, alpha_b, a_b)
+        body_terms(i, com, inertia, R, w, alpha_b, a_b, c, Iw, aG_b, gyro, S3, t1, t2)
         com_jacobian(i, c, JT, JR, anc_ptr, anc_idx, JG)
-        fT = F[i] - m_i * aG_b
-        fR = N[i] - gyro
+        for k in range(3):
+            fT[k] = F[i, k] - m_i * aG_b[k]
+            fR[k] = N[i, k] - gyro[k]
         lo, hi = anc_ptr[i], anc_ptr[i + 1]
         for m in range(lo, hi):
             col = anc_idx[m]
@@ -89,12 +121,15 @@ def jourdain(mass, com, inertia, has_inertia, R, w, alpha_b, a_b, JR, JT, anc_pt
             a_ = anc_idx[m]
             f[a_] += (JG[0, a_] * fT[0] + JG[1, a_] * fT[1] + JG[2, a_] * fT[2]
                       + JR[i, 0, a_] * fR[0] + JR[i, 1, a_] * fR[1] + JR[i, 2, a_] * fR[2])
-            for mm in range(lo, hi):
+            for mm in range(m, hi):           # upper triangle, mirrored below
                 b_ = anc_idx[mm]
                 M[a_, b_] += (m_i * (JG[0, a_] * JG[0, b_] + JG[1, a_] * JG[1, b_]
                                      + JG[2, a_] * JG[2, b_])
                               + JR[i, 0, a_] * IJ[0, b_] + JR[i, 1, a_] * IJ[1, b_]
                               + JR[i, 2, a_] * IJ[2, b_])
+    for a_ in range(nu):
+        for b_ in range(a_ + 1, nu):
+            M[b_, a_] = M[a_, b_]
 
 
 @njit(cache=True)
@@ -147,8 +182,19 @@ def newton_euler_system(mass, com, inertia, parent, R, r, w, alpha_b, a_b, JR, J
     nu = JR.shape[2]
     A[:, :] = 0.0
     JG = np.zeros((3, nu))
+    c = np.empty(3)
+    cp = np.empty(3)
+    Iw = np.empty((3, 3))
+    S3 = np.empty((3, 3))
+    aG_b = np.empty(3)
+    gyro = np.empty(3)
+    t1 = np.empty(3)
+    t2 = np.empty(3)
+    Fk = np.empty(3)
+    Nk = np.empty(3)
+    lever = np.empty(3)
     for i in range(n):
-        c, Iw, aG_b, gyro = body_terms(i, mass, com, inertia, R, w, alpha_b, a_b)
+        body_terms(i, com, inertia, R, w, alpha_b, a_b, c, Iw, aG_b, gyro, S3, t1, t2)
         com_jacobian(i, c, JT, JR, anc_ptr, anc_idx, JG)
         m_i = mass[i]
         for m in range(anc_ptr[i], anc_ptr[i + 1]):
@@ -163,20 +209,22 @@ def newton_euler_system(mass, com, inertia, parent, R, r, w, alpha_b, a_b, JR, J
     for k in range(react_joint.shape[0]):
         i = react_joint[k]
         col = nu + k
-        Fk = R[i] @ react_force[k]
-        Nk = R[i] @ react_moment[k]
-        lever = R[i] @ com[i]                        # child's centre of mass -> joint is -lever
-        Mi = Nk - cross(lever, Fk)
+        mat_vec(R[i], react_force[k], Fk)
+        mat_vec(R[i], react_moment[k], Nk)
+        mat_vec(R[i], com[i], c)                     # child's centre of mass -> joint is -c
+        cross_to(c, Fk, t1)
         for q in range(3):
             A[6 * i + q, col] -= Fk[q]
-            A[6 * i + 3 + q, col] -= Mi[q]
+            A[6 * i + 3 + q, col] -= Nk[q] - t1[q]
         p = parent[i]
         if p >= 0:
-            lever_p = r[i] - (r[p] + R[p] @ com[p])  # parent's centre of mass -> joint
-            Mp = Nk + cross(lever_p, Fk)
+            mat_vec(R[p], com[p], cp)
+            for q in range(3):
+                lever[q] = r[i, q] - r[p, q] - cp[q]  # parent's centre of mass -> joint
+            cross_to(lever, Fk, t1)
             for q in range(3):
                 A[6 * p + q, col] += Fk[q]
-                A[6 * p + 3 + q, col] += Mp[q]
+                A[6 * p + 3 + q, col] += Nk[q] + t1[q]
 
 
 @njit(cache=True)

@@ -15,6 +15,8 @@ gives, from the joint's own coordinates ``qj``, speeds ``uj`` and speed rates ``
 import numpy as np
 from numba import njit
 
+from .linalg3 import cross_to, mat_mat, mat_t_vec
+
 FIXED, REVOLUTE, PRISMATIC, EULER, SPHERICAL, FREE = 0, 1, 2, 3, 4, 5
 KIND_CODES = {"fixed": FIXED, "revolute": REVOLUTE, "prismatic": PRISMATIC,
               "euler": EULER, "spherical": SPHERICAL, "free": FREE}
@@ -94,45 +96,36 @@ def quaternion_rate(q, w, out):
 
 
 @njit(cache=True)
-def _cross(a, b, out):
-    out[0] = a[1] * b[2] - a[2] * b[1]
-    out[1] = a[2] * b[0] - a[0] * b[2]
-    out[2] = a[0] * b[1] - a[1] * b[0]
-
-
-@njit(cache=True)
-def euler_rate_matrix(seq, angles, Hw, hw, rates):
+def euler_rate_matrix(seq, angles, rates, Hw, hw, Sm, Sv):
     """Relative angular velocity of an Euler-angle joint, child components.
 
     ``Rrel = R_{s0}(q0) R_{s1}(q1) R_{s2}(q2)`` (rotations about moving axes), so
     ``w = R2^T R1^T e_{s0} q0' + R2^T e_{s1} q1' + e_{s2} q2'``.  Fills the columns of
-    ``Hw`` and the velocity product ``hw = Hw' q'``.
+    ``Hw`` and the velocity product ``hw = Hw' q'``, using
+    ``d/dt R^T(q) x = -q' e x (R^T x) + R^T x'``.  ``Sm`` (>= 2x3x3) and ``Sv`` (>= 8x3)
+    are scratch.
     """
-    R1 = np.empty((3, 3))
-    R2 = np.empty((3, 3))
+    R1 = Sm[0]
+    R2 = Sm[1]
     rotation_about_coordinate_axis(seq[1], angles[1], R1)
     rotation_about_coordinate_axis(seq[2], angles[2], R2)
-    e0 = np.zeros(3)
-    e1 = np.zeros(3)
-    e2 = np.zeros(3)
-    e0[seq[0]] = 1.0
+    y, c0, c1, e1, e2, t0, t1, t2 = Sv[0], Sv[1], Sv[2], Sv[3], Sv[4], Sv[5], Sv[6], Sv[7]
+    for k in range(3):
+        y[k] = R1[seq[0], k]               # R1^T e_{s0}
+        c1[k] = R2[seq[1], k]              # R2^T e_{s1}
+        e1[k] = 0.0
+        e2[k] = 0.0
     e1[seq[1]] = 1.0
     e2[seq[2]] = 1.0
-    y = R1.T @ e0                      # R1^T e0
-    c0 = R2.T @ y
-    c1 = R2.T @ e1
+    mat_t_vec(R2, y, c0)                   # R2^T R1^T e_{s0}
     for k in range(3):
         Hw[k, 0] = c0[k]
         Hw[k, 1] = c1[k]
         Hw[k, 2] = e2[k]
-    # d/dt R^T(q) x = -q' e x (R^T x) + R^T x'
-    t0 = np.empty(3)
-    t1 = np.empty(3)
-    t2 = np.empty(3)
-    _cross(e1, y, t0)                  # e1 x (R1^T e0)
-    t0 = R2.T @ t0
-    _cross(e2, c0, t1)                 # e2 x c0
-    _cross(e2, c1, t2)                 # e2 x c1
+    cross_to(e1, y, t1)
+    mat_t_vec(R2, t1, t0)                  # R2^T (e1 x R1^T e0)
+    cross_to(e2, c0, t1)
+    cross_to(e2, c1, t2)
     for k in range(3):
         dc0 = -rates[2] * t1[k] - rates[1] * t0[k]
         dc1 = -rates[2] * t2[k]
@@ -140,8 +133,9 @@ def euler_rate_matrix(seq, angles, Hw, hw, rates):
 
 
 @njit(cache=True)
-def joint_motion(kind, axis, seq, qj, uj, Rrel, d, Hw, Hv, hw, hv):
-    """Relative motion of one joint; see the module docstring for the outputs."""
+def joint_motion(kind, axis, seq, qj, uj, Rrel, d, Hw, Hv, hw, hv, Sm, Sv):
+    """Relative motion of one joint; see the module docstring for the outputs.
+    ``Sm`` (4x3x3) and ``Sv`` (8x3) are scratch."""
     for k in range(3):
         d[k] = 0.0
         hw[k] = 0.0
@@ -150,25 +144,27 @@ def joint_motion(kind, axis, seq, qj, uj, Rrel, d, Hw, Hv, hw, hv):
             Hw[k, c] = 0.0
             Hv[k, c] = 0.0
     if kind == FIXED:
-        Rrel[:, :] = np.eye(3)
+        for i in range(3):
+            for j in range(3):
+                Rrel[i, j] = 1.0 if i == j else 0.0
     elif kind == REVOLUTE:
         rotation_about_axis(axis, qj[0], Rrel)
         for k in range(3):
             Hw[k, 0] = axis[k]
     elif kind == PRISMATIC:
-        Rrel[:, :] = np.eye(3)
+        for i in range(3):
+            for j in range(3):
+                Rrel[i, j] = 1.0 if i == j else 0.0
         for k in range(3):
             d[k] = axis[k] * qj[0]
             Hv[k, 0] = axis[k]
     elif kind == EULER:
-        R0 = np.empty((3, 3))
-        R1 = np.empty((3, 3))
-        R2 = np.empty((3, 3))
-        rotation_about_coordinate_axis(seq[0], qj[0], R0)
-        rotation_about_coordinate_axis(seq[1], qj[1], R1)
-        rotation_about_coordinate_axis(seq[2], qj[2], R2)
-        Rrel[:, :] = R0 @ R1 @ R2
-        euler_rate_matrix(seq, qj, Hw, hw, uj)
+        rotation_about_coordinate_axis(seq[0], qj[0], Sm[2])
+        rotation_about_coordinate_axis(seq[1], qj[1], Sm[0])
+        rotation_about_coordinate_axis(seq[2], qj[2], Sm[1])
+        mat_mat(Sm[2], Sm[0], Sm[3])
+        mat_mat(Sm[3], Sm[1], Rrel)
+        euler_rate_matrix(seq, qj, uj, Hw, hw, Sm, Sv)
     elif kind == SPHERICAL:
         quaternion_to_matrix(qj, Rrel)
         for k in range(3):

@@ -17,10 +17,12 @@ import numpy as np
 from numba import njit
 
 from .joints import MAX_NU, joint_motion
+from .linalg3 import cross_to, mat_mat, mat_vec
 
 
 @njit(cache=True)
 def cross(a, b):
+    """``a x b`` as a new array (for code off the hot path)."""
     return np.array((a[1] * b[2] - a[2] * b[1],
                      a[2] * b[0] - a[0] * b[2],
                      a[0] * b[1] - a[1] * b[0]))
@@ -37,21 +39,27 @@ def forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_pt
     """
     n = parent.shape[0]
     Rrel = np.empty((3, 3))
+    RJ0 = np.empty((3, 3))
     d = np.empty(3)
     Hw = np.empty((3, MAX_NU))
     Hv = np.empty((3, MAX_NU))
     hw = np.empty(3)
     hv = np.empty(3)
-    zero3 = np.zeros(3)
-    eye3 = np.eye(3)
+    Sm = np.empty((4, 3, 3))
+    Sv = np.empty((8, 3))
+    rho = np.empty(3)
+    wrel_b = np.empty(3)
+    dwrel_b = np.empty(3)
+    vrel_j = np.empty(3)
+    dvrel_j = np.empty(3)
+    wrel = np.empty(3)
+    vrel = np.empty(3)
+    t1 = np.empty(3)
+    t2 = np.empty(3)
+    t3 = np.empty(3)
+    t4 = np.empty(3)
     for i in range(n):
         p = parent[i]
-        if p >= 0:
-            Rp = R[p]
-            rp, wp, vp, alp, ap = r[p], w[p], v[p], alpha[p], a[p]
-        else:
-            Rp = eye3
-            rp, wp, vp, alp, ap = zero3, zero3, zero3, zero3, zero3
         k0 = qoff[i]
         j0 = uoff[i]
         kd = kind[i]
@@ -60,30 +68,63 @@ def forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_pt
         qj = qfull[k0:k0 + nq]
         uj = ufull[j0:j0 + nu]
         udj = udfull[j0:j0 + nu]
-        joint_motion(kd, axis[i], seq[i], qj, uj, Rrel, d, Hw, Hv, hw, hv)
+        joint_motion(kd, axis[i], seq[i], qj, uj, Rrel, d, Hw, Hv, hw, hv, Sm, Sv)
 
-        RJ0 = Rp @ C[i]
-        R[i] = RJ0 @ Rrel
-        rho = Rp @ pos[i] + RJ0 @ d                  # parent origin -> child origin
-        r[i] = rp + rho
-        # relative velocities and accelerations of the joint
-        wrel_b = np.zeros(3)
-        dwrel_b = hw.copy()
-        vrel_j = np.zeros(3)
-        dvrel_j = hv.copy()
+        # orientation and position: J0 = parent (x) placement, child = J0 (x) joint
+        if p >= 0:
+            mat_mat(R[p], C[i], RJ0)
+            mat_vec(R[p], pos[i], rho)
+        else:
+            RJ0[:, :] = C[i]
+            rho[:] = pos[i]
+        mat_mat(RJ0, Rrel, R[i])
+        mat_vec(RJ0, d, t1)
+        for k in range(3):
+            rho[k] += t1[k]                   # parent origin -> child origin
+        # relative velocities and accelerations of the joint (child / J0 components)
+        for k in range(3):
+            wrel_b[k] = 0.0
+            dwrel_b[k] = hw[k]
+            vrel_j[k] = 0.0
+            dvrel_j[k] = hv[k]
         for c in range(nu):
             for k in range(3):
                 wrel_b[k] += Hw[k, c] * uj[c]
                 dwrel_b[k] += Hw[k, c] * udj[c]
                 vrel_j[k] += Hv[k, c] * uj[c]
                 dvrel_j[k] += Hv[k, c] * udj[c]
-        wrel = R[i] @ wrel_b
-        vrel = RJ0 @ vrel_j
-        w[i] = wp + wrel
-        v[i] = vp + cross(wp, rho) + vrel
-        alpha[i] = alp + cross(wp, wrel) + R[i] @ dwrel_b
-        a[i] = (ap + cross(alp, rho) + cross(wp, cross(wp, rho))
-                + 2.0 * cross(wp, vrel) + RJ0 @ dvrel_j)
+        mat_vec(R[i], wrel_b, wrel)
+        mat_vec(RJ0, vrel_j, vrel)
+        mat_vec(R[i], dwrel_b, t3)            # relative angular acceleration, world
+        mat_vec(RJ0, dvrel_j, t4)             # relative acceleration, world
+        if p >= 0:
+            wp = w[p]
+            cross_to(wp, rho, t1)
+            for k in range(3):
+                r[i, k] = r[p, k] + rho[k]
+                w[i, k] = wp[k] + wrel[k]
+                v[i, k] = v[p, k] + t1[k] + vrel[k]
+            # alpha = alpha_p + w_p x w_rel + R dw_rel
+            cross_to(wp, wrel, t2)
+            for k in range(3):
+                alpha[i, k] = alpha[p, k] + t2[k] + t3[k]
+            # a = a_p + alpha_p x rho + w_p x (w_p x rho) + 2 w_p x v_rel + RJ0 d''
+            cross_to(wp, t1, t2)              # w_p x (w_p x rho)
+            for k in range(3):
+                t4[k] += t2[k]
+            cross_to(alpha[p], rho, t2)
+            for k in range(3):
+                t4[k] += t2[k]
+            cross_to(wp, vrel, t2)
+            for k in range(3):
+                a[i, k] = a[p, k] + t4[k] + 2.0 * t2[k]
+        else:
+            for k in range(3):
+                r[i, k] = rho[k]
+                w[i, k] = wrel[k]
+                v[i, k] = vrel[k]
+                alpha[i, k] = t3[k]
+                a[i, k] = t4[k]
 
         # Jacobians: inherit the parent's columns, then add this joint's own
         if p >= 0:
@@ -98,13 +139,13 @@ def forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_pt
                 JT[i, 1, col] = JT[p, 1, col] + jr2 * rho[0] - jr0 * rho[2]
                 JT[i, 2, col] = JT[p, 2, col] + jr0 * rho[1] - jr1 * rho[0]
         if ucol[i] >= 0:
-            Hw_w = R[i] @ Hw
-            Hv_w = RJ0 @ Hv
+            Ri = R[i]
             for c in range(nu):
                 col = ucol[i] + c
                 for k in range(3):
-                    JR[i, k, col] = Hw_w[k, c]
-                    JT[i, k, col] = Hv_w[k, c]
+                    JR[i, k, col] = Ri[k, 0] * Hw[0, c] + Ri[k, 1] * Hw[1, c] + Ri[k, 2] * Hw[2, c]
+                    JT[i, k, col] = (RJ0[k, 0] * Hv[0, c] + RJ0[k, 1] * Hv[1, c]
+                                     + RJ0[k, 2] * Hv[2, c])
 
 
 @njit(cache=True)
