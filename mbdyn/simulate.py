@@ -53,7 +53,8 @@ class Result:
     by name; ``events`` is ``[(name, t), ...]``; ``stats`` the integrator's statistics;
     on request ``reactions`` ``{joint: (n, 6)}`` (force then moment, world components, at
     the joint origin), ``energy`` ``{"kinetic", "potential", "total"}`` and ``points``
-    ``{name: (n, 3)}``.
+    ``{name: (n, 3)}``.  With energies, ``stats["energy_drift"]`` is
+    ``max |E(t) - E(0)|`` over the energy scale ``max(|E(0)|, max T, max |V|)``.
     """
 
     def __init__(self, model, t, q, u, events, stats):
@@ -212,7 +213,8 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator="RK45", rtol=
              atol=1e-9, dt=None, method="jourdain", events=(), t_eval=None, max_step=np.inf,
              outputs=(), points=None, progress=None, singularity_threshold=1e-3,
              compiled_loop=True):
-    """Integrate ``model`` from ``t0`` to ``t_end``.
+    """Integrate ``model`` (a compiled ``Model``, or a ``System`` to compile) from ``t0``
+    to ``t_end``.
 
     ``q0``/``u0``: arrays or ``{name: value}`` over the defaults (zero, identity
     quaternions).  ``integrator``: one of ``INTEGRATORS``; the fixed-step ones need ``dt``.
@@ -231,6 +233,8 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator="RK45", rtol=
     Raises ``SimulationError`` (its ``result`` holds the motion up to the failure) when
     the integrator fails or NaN/Inf appears.
     """
+    if not hasattr(model, "forward_dynamics") and hasattr(model, "compile"):
+        model = model.compile()           # a System: compile it here
     if integrator not in INTEGRATORS:
         raise ModelError(f"unknown integrator {integrator!r}; use one of {', '.join(INTEGRATORS)}")
     if method not in ("jourdain", "newton-euler"):
