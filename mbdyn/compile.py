@@ -239,6 +239,11 @@ class Model:
                               self._load_moment, self._load_in_body)
         self._kin_out = (self._R, self._r, self._w, self._v, self._alpha, self._a,
                          self._JR, self._JT, self._F, self._N)
+        self._ud = np.zeros(self.nu)
+        self._jourdain_args = (*self._tree, self._mass, self._com, self._inertia,
+                               self._has_inertia, self.gravity, self._qfull, self._ufull,
+                               self._udfull, *self._loads_arrays, *self._kin_out, self._M,
+                               self._f, self._L, self._ud)
 
     def _lambdify_load(self, name, exprs):
         """A callable ``(t, q, u) -> 3 values`` from sympy expressions of ``t`` and the
@@ -345,8 +350,12 @@ class Model:
         if q.shape != (self.nq,) or u.shape != (self.nu,):
             raise ModelError(f"model {self.name!r} expects q of length {self.nq} and u of "
                              f"length {self.nu}, got {q.shape} and {u.shape}")
-        self._qfull[self._free_q] = q
-        self._ufull[self._free_u] = u
+        if self._driven:
+            self._qfull[self._free_q] = q
+            self._ufull[self._free_u] = u
+        else:                             # every joint is free: the layouts coincide
+            self._qfull[:] = q
+            self._ufull[:] = u
         self._udfull[:] = 0.0
         for name, kq, ku, drive in self._driven:
             self._qfull[kq] = drive.position(t)
@@ -448,19 +457,17 @@ class Model:
         the Newton-Euler system with reactions (``method="newton-euler"``)."""
         if method == "jourdain":
             q, u = self._fill(q, u, t)
-            ud = np.empty(self.nu)
-            pivot = ke.jourdain_accelerations(
-                *self._tree, self._mass, self._com, self._inertia, self._has_inertia,
-                self.gravity, self._qfull, self._ufull, self._udfull, *self._loads_arrays,
-                *self._kin_out, self._M, self._f, self._L, ud)
+            pivot = ke.jourdain_accelerations(*self._jourdain_args)
             if pivot >= 0:
                 self._raise_singular(q, t, pivot)
-        elif method == "newton-euler":
+            if pivot == -2:
+                self._check_finite(q, u, t, self._ud, "the accelerations")
+            return self._ud.copy()
+        if method == "newton-euler":
             ud = self._newton_euler(q, u, t)[:self.nu].copy()
-        else:
-            raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")
-        self._check_finite(q, u, t, ud, "the accelerations")
-        return ud
+            self._check_finite(q, u, t, ud, "the accelerations")
+            return ud
+        raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")
 
     def _newton_euler(self, q, u, t):
         q, u = self._fill(q, u, t)

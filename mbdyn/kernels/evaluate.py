@@ -29,7 +29,8 @@ def jourdain_accelerations(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, an
                            R, r, w, v, alpha, a, JR, JT, F, N, M, f, L, ud):
     """Kinematics, loads, ``M`` and ``f``, then ``ud = M^-1 f`` by Cholesky.
 
-    Returns -1, or the index of the speed where the Cholesky factorisation broke down.
+    Returns -1 on success, the index of the speed where the Cholesky factorisation broke
+    down, or -2 when ``ud`` holds NaN or Inf.
     """
     kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                          mass, com, gravity, qfull, ufull, udfull,
@@ -37,7 +38,13 @@ def jourdain_accelerations(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, an
                          R, r, w, v, alpha, a, JR, JT, F, N)
     jourdain(mass, com, inertia, has_inertia, R, w, alpha, a, JR, JT, anc_ptr, anc_idx,
              F, N, M, f)
-    return cholesky_solve(M, f, L, ud)
+    pivot = cholesky_solve(M, f, L, ud)
+    if pivot >= 0:
+        return pivot
+    for k in range(ud.shape[0]):
+        if not np.isfinite(ud[k]):
+            return -2
+    return -1
 
 
 @njit(cache=True)
