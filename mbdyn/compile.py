@@ -240,10 +240,15 @@ class Model:
         self._kin_out = (self._R, self._r, self._w, self._v, self._alpha, self._a,
                          self._JR, self._JT, self._F, self._N)
         self._ud = np.zeros(self.nu)
+        self._slots = np.array(self._free_joint_slots, np.int64).reshape(-1, 5)
         self._jourdain_args = (*self._tree, self._mass, self._com, self._inertia,
                                self._has_inertia, self.gravity, self._qfull, self._ufull,
                                self._udfull, *self._loads_arrays, *self._kin_out, self._M,
                                self._f, self._L, self._ud)
+        self._newton_euler_args = (*self._tree, self._mass, self._com, self._inertia,
+                                   self.gravity, self._qfull, self._ufull, self._udfull,
+                                   *self._loads_arrays, self._react_joint, self._react_force,
+                                   self._react_moment, *self._kin_out, self._A, self._b)
 
     def _lambdify_load(self, name, exprs):
         """A callable ``(t, q, u) -> 3 values`` from sympy expressions of ``t`` and the
@@ -464,23 +469,19 @@ class Model:
                 self._check_finite(q, u, t, self._ud, "the accelerations")
             return self._ud.copy()
         if method == "newton-euler":
-            ud = self._newton_euler(q, u, t)[:self.nu].copy()
-            self._check_finite(q, u, t, ud, "the accelerations")
-            return ud
+            return self._newton_euler(q, u, t)[:self.nu].copy()
         raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")
 
     def _newton_euler(self, q, u, t):
         q, u = self._fill(q, u, t)
         try:
-            x = ke.newton_euler_solution(
-                *self._tree, self._mass, self._com, self._inertia, self.gravity,
-                self._qfull, self._ufull, self._udfull, *self._loads_arrays,
-                self._react_joint, self._react_force, self._react_moment,
-                *self._kin_out, self._A, self._b)
+            x = ke.newton_euler_solution(*self._newton_euler_args)
         except np.linalg.LinAlgError:
             self._jourdain_terms(q, u, t)
             self._raise_singular(q, t, None)
-        self._check_finite(q, u, t, x, "the Newton-Euler solution")
+        total = x.sum()
+        if not total - total == 0.0:      # NaN or Inf somewhere: find and report it
+            self._check_finite(q, u, t, x, "the Newton-Euler solution")
         return x
 
     def _raise_singular(self, q, t, pivot):
@@ -566,10 +567,8 @@ class Model:
         u = np.asarray(u, dtype=float)
         if not self._quaternions:
             return u.copy()
-        q = np.asarray(q, dtype=float)
         qd = np.empty(self.nq)
-        for code, qi, nq, ui, nu in self._free_joint_slots:
-            kj.joint_coordinate_rates(code, q[qi:qi + nq], u[ui:ui + nu], qd[qi:qi + nq])
+        kj.coordinate_rates(np.asarray(q, dtype=float), u, self._slots, qd)
         return qd
 
     def energy(self, q, u, t=0.0):
@@ -601,7 +600,7 @@ class Model:
     def loop_arguments(self):
         """The arrays ``kernels.integrators.fixed_step_loop`` needs after its drive table:
         ``(nq, slots, quats, free_q, free_u, drive_q, drive_u, tree, body, loads, ws)``."""
-        slots = np.array(self._free_joint_slots, np.int64).reshape(-1, 5)
+        slots = self._slots
         quats = np.array([s.start for s in self._quaternions], np.int64)
         drive_q = np.array([d[1] for d in self._driven], np.int64)
         drive_u = np.array([d[2] for d in self._driven], np.int64)

@@ -18,7 +18,7 @@ import numpy as np
 from numba import njit
 
 from .evaluate import jourdain_accelerations
-from .joints import joint_coordinate_rates
+from .joints import coordinate_rates
 
 EULER, SEMI_IMPLICIT_EULER, RK4, IMPLICIT_MIDPOINT = 0, 1, 2, 3
 SCHEMES = {"euler": EULER, "semi-implicit-euler": SEMI_IMPLICIT_EULER, "rk4": RK4,
@@ -30,10 +30,7 @@ STAGES = (0.0, 0.5, 1.0)
 @njit(cache=True)
 def _rates(y, nq, slots, out):
     """``q' = N(q) u`` into ``out[:nq]``."""
-    for s in range(slots.shape[0]):
-        code, qi, nqj, ui, nuj = slots[s, 0], slots[s, 1], slots[s, 2], slots[s, 3], slots[s, 4]
-        joint_coordinate_rates(code, y[qi:qi + nqj], y[nq + ui:nq + ui + nuj],
-                               out[qi:qi + nqj])
+    coordinate_rates(y[:nq], y[nq:], slots, out[:nq])
 
 
 @njit(cache=True)

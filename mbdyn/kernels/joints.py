@@ -189,3 +189,11 @@ def joint_coordinate_rates(kind, qj, uj, out):
     else:
         for k in range(uj.shape[0]):
             out[k] = uj[k]
+
+
+@njit(cache=True)
+def coordinate_rates(q, u, slots, out):
+    """``q' = N(q) u`` for every free joint; ``slots[s] = (kind, q start, nq, u start, nu)``."""
+    for s in range(slots.shape[0]):
+        code, qi, nqj, ui, nuj = slots[s, 0], slots[s, 1], slots[s, 2], slots[s, 3], slots[s, 4]
+        joint_coordinate_rates(code, q[qi:qi + nqj], u[ui:ui + nuj], out[qi:qi + nqj])
