@@ -406,9 +406,9 @@ class Model:
 
     def _jourdain_terms(self, q, u, t):
         q, u = self._kinematics_kernel(q, u, t)
-        kd.jourdain(self._mass, self._com, self._inertia, self._has_inertia, self._R, self._w,
-                    self._alpha, self._a, self._JR, self._JT, self._anc_ptr, self._anc_idx,
-                    self._F, self._N, self._M, self._f)
+        kd.jourdain(self._mass, self._com, self._inertia, self._has_inertia, self._R, self._r,
+                    self._w, self._alpha, self._a, self._JR, self._JT, self._anc_ptr,
+                    self._anc_idx, self._parent, self._F, self._N, self._M, self._f)
         return q, u
 
     # ------------------------------------------------------------------ public numerics

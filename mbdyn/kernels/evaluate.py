@@ -36,8 +36,8 @@ def jourdain_accelerations(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, an
                          mass, com, gravity, qfull, ufull, udfull,
                          load_body, load_point, load_force, load_moment, load_in_body,
                          R, r, w, v, alpha, a, JR, JT, F, N)
-    jourdain(mass, com, inertia, has_inertia, R, w, alpha, a, JR, JT, anc_ptr, anc_idx,
-             F, N, M, f)
+    jourdain(mass, com, inertia, has_inertia, R, r, w, alpha, a, JR, JT, anc_ptr, anc_idx,
+             parent, F, N, M, f)
     pivot = cholesky_solve(M, f, L, ud)
     if pivot >= 0:
         return pivot
