@@ -573,15 +573,20 @@ class Model:
 
     def energy(self, q, u, t=0.0):
         """Kinetic and gravitational potential energy ``(T, V)``; ``V = -sum m g . r_G``."""
-        k = self.kinematics(q, u, t=t)
-        T = 0.0
-        V = 0.0
-        for i in range(self.n_frames):
-            R = k.R[i]
-            Iw = R @ self._inertia[i] @ R.T
-            T += 0.5 * self._mass[i] * k.v_com[i] @ k.v_com[i] + 0.5 * k.w[i] @ Iw @ k.w[i]
-            V -= self._mass[i] * self.gravity @ k.r_com[i]
-        return T, V
+        self._kinematics_kernel(q, u, t)
+        T, V = kd.energies(self._mass, self._com, self._inertia, self.gravity, self._R,
+                           self._r, self._w, self._v)
+        return float(T), float(V)
+
+    def point_positions(self, q, points, t=0.0):
+        """World positions of points fixed on frames: ``points`` is a list of
+        ``(frame, offset in the frame's components)``; returns an array (len(points), 3)."""
+        self._kinematics_kernel(q, np.zeros(self.nu), t)
+        out = np.empty((len(points), 3))
+        for k, (frame, offset) in enumerate(points):
+            i = self.frame_index(frame)
+            out[k] = self._r[i] + self._R[i] @ np.asarray(offset, dtype=float)
+        return out
 
     # ------------------------------------------------------------------ compiled loops
     @property

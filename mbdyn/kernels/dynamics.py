@@ -326,3 +326,26 @@ def joint_wrenches(mass, com, inertia, parent, R, r, w, alpha, a, F, N, out):
             for k in range(3):
                 out[p, k] += fi[k]
                 out[p, 3 + k] += mp[k]
+
+
+@njit(cache=True)
+def energies(mass, com, inertia, gravity, R, r, w, v):
+    """Kinetic energy ``T = sum 1/2 m |v_G|^2 + 1/2 w . I w`` and gravitational potential
+    ``V = -sum m g . r_G`` of the whole system."""
+    T = 0.0
+    V = 0.0
+    c = np.empty(3)
+    vG = np.empty(3)
+    Iw = np.empty((3, 3))
+    S3 = np.empty((3, 3))
+    Iww = np.empty(3)
+    for i in range(mass.shape[0]):
+        mat_vec(R[i], com[i], c)
+        cross_to(w[i], c, vG)
+        rotate_tensor(R[i], inertia[i], S3, Iw)
+        mat_vec(Iw, w[i], Iww)
+        for k in range(3):
+            vG[k] += v[i, k]
+            T += 0.5 * (mass[i] * vG[k] * vG[k] + w[i, k] * Iww[k])
+            V -= mass[i] * gravity[k] * (r[i, k] + c[k])
+    return T, V
