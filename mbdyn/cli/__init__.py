@@ -1,0 +1,110 @@
+"""The ``mbdyn`` command: ``mbdyn run MODEL ...``, ``mbdyn info MODEL ...``.
+
+Each command is a submodule ``mbdyn.cli.NAME`` listed in ``COMMANDS`` with a
+``register(subparsers)`` function that adds its parser and sets ``func`` (called with the
+parsed arguments, returns the exit code).  To add a command, write the module and append
+its name to ``COMMANDS``.
+
+Exit codes: 0 success; 1 a model file or input that cannot be used (one-line message on
+stderr); 2 a bad command line; 3 a simulation that failed (NaN, singularity, integrator
+failure); 130 interrupted.  No traceback unless ``MBDYN_DEBUG=1``.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import sys
+import warnings
+
+COMMANDS = ["run", "info", "eom", "accuracy"]
+
+EXIT_OK, EXIT_INPUT, EXIT_USAGE, EXIT_SIMULATION, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
+
+
+class ArgumentParser(argparse.ArgumentParser):
+    """argparse with one-line errors on stderr (exit code 2)."""
+
+    def error(self, message):
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def build_parser():
+    from .. import __version__
+    parser = ArgumentParser(
+        prog="mbdyn",
+        description="Multibody dynamics after Dynamics of Machines II: run and inspect "
+                    "model files (see docs/model-files.md).")
+    parser.add_argument("--version", action="version", version=f"mbdyn {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=ArgumentParser)
+    for name in COMMANDS:
+        importlib.import_module(f"{__name__}.{name}").register(sub)
+    return parser
+
+
+def _one_line(text):
+    return " ".join(str(text).split())
+
+
+def _error(message):
+    sys.stderr.write(f"mbdyn: error: {_one_line(message)}\n")
+
+
+def main(argv=None):
+    """Run the command line ``argv`` (default ``sys.argv[1:]``); returns the exit code."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:             # --help, --version, usage errors
+        return exc.code if isinstance(exc.code, int) else EXIT_USAGE
+    if not getattr(args, "command", None):
+        parser.print_usage(sys.stderr)
+        _error("give a command: " + ", ".join(COMMANDS) + " (see mbdyn --help)")
+        return EXIT_USAGE
+    from ..errors import ModelError, SimulationError
+    debug = bool(os.environ.get("MBDYN_DEBUG"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        seen = set()
+
+        def show(message, category, filename, lineno, file=None, line=None):
+            text = _one_line(message)
+            if text not in seen:
+                seen.add(text)
+                sys.stderr.write(f"mbdyn: warning: {text}\n")
+        warnings.showwarning = show
+        try:
+            return args.func(args) or EXIT_OK
+        except KeyboardInterrupt:
+            sys.stderr.write("\nmbdyn: interrupted\n")
+            return EXIT_INTERRUPTED
+        except SimulationError as exc:
+            if debug:
+                raise
+            _error(f"simulation failed: {exc}")
+            return EXIT_SIMULATION
+        except ModelError as exc:
+            if debug:
+                raise
+            _error(exc)
+            return EXIT_INPUT
+        except ArithmeticError as exc:     # NonFiniteError, SingularMassMatrixError at t0
+            if debug:
+                raise
+            _error(f"simulation failed: {exc}")
+            return EXIT_SIMULATION
+        except OSError as exc:
+            if debug:
+                raise
+            where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
+            _error(f"{where}{exc.strerror or exc}")
+            return EXIT_INPUT
+        except Exception as exc:          # a bug: still one line, traceback on request
+            if debug:
+                raise
+            _error(f"internal error ({type(exc).__name__}: {exc}); please report it -- "
+                   "MBDYN_DEBUG=1 shows the traceback")
+            return 70
+
+
+__all__ = ["main", "COMMANDS", "build_parser"]

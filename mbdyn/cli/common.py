@@ -1,0 +1,90 @@
+"""Arguments and helpers shared by the ``mbdyn`` commands."""
+from __future__ import annotations
+
+import sys
+import time
+import warnings
+
+from ..io.loader import load_model
+from ..io.schema import parse_set_value
+
+
+def add_model_arguments(parser):
+    """``MODEL [--case NAME] [--set PATH=VALUE ...]``."""
+    parser.add_argument("model", metavar="MODEL", help="model file (.toml)")
+    parser.add_argument("--case", metavar="NAME",
+                        help="apply the file's [cases.NAME] (default: model.default_case)")
+    parser.add_argument("--set", dest="overrides", metavar="PATH=VALUE", action="append",
+                        default=[],
+                        help="override a value by its dotted path after the case, e.g. "
+                             "parameters.b=0.3, initial.beta=pi/8, bodies.disk.mass=2 "
+                             "(repeatable)")
+
+
+def overrides(args, flags=()):
+    """``--set`` texts, then the ``(path, flag)`` options given (e.g. ``--dt``), as
+    ``(path, value, origin)`` triples for ``load_model``."""
+    out = list(args.overrides)
+    for path, flag in flags:
+        value = getattr(args, flag.lstrip("-").replace("-", "_"), None)
+        if value is None:
+            continue
+        parsed = parse_set_value(value) if isinstance(value, str) else value
+        out.append((path, parsed, f"{flag} {value}"))
+    return out
+
+
+def load(args, flags=(), record_warnings=False):
+    """The ``Scene`` of the command line's model, case and overrides."""
+    if record_warnings:
+        with warnings.catch_warnings(record=True):
+            warnings.simplefilter("always")
+            return load_model(args.model, case=args.case, overrides=overrides(args, flags))
+    return load_model(args.model, case=args.case, overrides=overrides(args, flags))
+
+
+def fmt(x):
+    """A number, briefly."""
+    try:
+        return f"{float(x):.6g}"
+    except (TypeError, ValueError):
+        return str(x)
+
+
+class Progress:
+    """``progress(t)`` for ``simulate``: after ``delay`` seconds of wall time, shows
+    ``t`` and the percentage done on ``stream`` (stderr), refreshed every ``interval``
+    seconds; only when the stream is a terminal (or ``force``)."""
+
+    def __init__(self, t_end, stream=None, delay=2.0, interval=0.2, force=False,
+                 clock=time.monotonic, t0=0.0):
+        self.stream = stream if stream is not None else sys.stderr
+        self.enabled = force or bool(getattr(self.stream, "isatty", lambda: False)())
+        self.t0, self.t_end = float(t0), float(t_end)
+        self.delay, self.interval = delay, interval
+        self.clock = clock
+        self.start = clock()
+        self.last = None
+        self.shown = False
+
+    def __call__(self, t):
+        if not self.enabled:
+            return
+        now = self.clock()
+        if now - self.start < self.delay:
+            return
+        if self.last is not None and now - self.last < self.interval:
+            return
+        self.last = now
+        span = max(self.t_end - self.t0, 1e-300)
+        pct = max(0.0, min(100.0, 100.0 * (float(t) - self.t0) / span))
+        self.stream.write(f"\rmbdyn: t = {float(t):.6g} of {self.t_end:g} s ({pct:5.1f}%), "
+                          f"{now - self.start:.0f} s elapsed")
+        self.stream.flush()
+        self.shown = True
+
+    def close(self):
+        if self.shown:
+            self.stream.write("\n")
+            self.stream.flush()
+            self.shown = False

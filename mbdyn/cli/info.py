@@ -1,0 +1,152 @@
+"""``mbdyn info MODEL``: what a model file holds -- bodies, joints, coordinates, speeds,
+degrees of freedom, drives, loads, events, settings and every validation warning."""
+from __future__ import annotations
+
+import json
+import sys
+import warnings
+
+import numpy as np
+
+from .common import add_model_arguments, fmt, load
+
+
+def register(subparsers):
+    p = subparsers.add_parser(
+        "info", help="describe a model file",
+        description="Describe a model file: bodies, joints, coordinates, speeds, degrees "
+                    "of freedom, drives, loads, events and every validation warning.")
+    add_model_arguments(p)
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=info)
+
+
+def _text(v):
+    if isinstance(v, list):
+        return "[" + ", ".join(_text(x) for x in v) + "]"
+    if isinstance(v, float):
+        return fmt(v)
+    return str(v)
+
+
+def describe(scene):
+    """The ``mbdyn info --json`` object."""
+    model = scene.model
+    bodies = []
+    for spec in scene.body_specs:
+        b = model.body(spec["name"])
+        bodies.append({"name": b.name, "mass": b.mass, "com": b.com.tolist(),
+                       "inertia": b.inertia.tolist(),
+                       "principal_moments": np.linalg.eigvalsh(b.inertia).tolist(),
+                       "massless": not b.has_inertia})
+    joints, drives = [], []
+    for spec in scene.joint_specs:
+        j = model.joint(spec["name"])
+        entry = {"name": j.name, "kind": j.kind, "parent": j.parent, "child": j.child,
+                 "coordinates": list(j.coordinates), "speeds": list(j.speeds),
+                 "driven": j.drive is not None}
+        if j.kind in ("revolute", "prismatic"):
+            entry["axis"] = j.axis.tolist()
+        if j.kind == "euler":
+            entry["sequence"] = "".join("XYZ"[k] for k in j.sequence)
+        if np.any(j.position):
+            entry["position"] = j.position.tolist()
+        if j.drive is not None:
+            entry["drive"] = str(spec["drive"])
+            drives.append({"joint": j.name, "coordinate": j.coordinates[0],
+                           "expression": str(spec["drive"])})
+        joints.append(entry)
+    loads = [{"name": ld["name"], "body": ld["body"], "force": ld.get("force"),
+              "moment": ld.get("moment"), "point": ld.get("point", [0, 0, 0]),
+              "frame": ld.get("frame", "world")} for ld in scene.load_specs]
+    return {
+        "model": scene.name, "file": scene.path, "description": scene.description,
+        "case": scene.case, "cases": list(scene.cases), "default_case": scene.default_case,
+        "parameters": scene.parameters, "gravity": model.gravity.tolist(),
+        "bodies": bodies, "joints": joints,
+        "coordinates": list(model.coordinates), "speeds": list(model.speeds),
+        "dof": model.nu, "drives": drives, "loads": loads,
+        "events": list(scene.event_specs), "initial": scene.initial_state,
+        "simulation": dict(scene.settings),
+        "outputs": {"reactions": list(scene.outputs["reactions"]),
+                    "reactions_frame": scene.outputs["reactions_frame"],
+                    "energy": scene.outputs["energy"],
+                    "points": {k: {"frame": f, "offset": list(o)}
+                               for k, (f, o) in scene.outputs["points"].items()}},
+        "warnings": list(scene.warnings),
+    }
+
+
+def info(args):
+    with warnings.catch_warnings(record=True):      # listed in the report, not on stderr
+        warnings.simplefilter("always")
+        scene = load(args)
+    d = describe(scene)
+    if args.json:
+        sys.stdout.write(json.dumps(d) + "\n")
+        return 0
+    w = sys.stdout.write
+    w(f"model        {d['model']}  ({d['file']})\n")
+    if d["description"]:
+        w(f"             {d['description']}\n")
+    if d["cases"]:
+        w(f"case         {d['case'] or '(none)'}   (cases: {', '.join(d['cases'])}"
+          f"{'; default ' + d['default_case'] if d['default_case'] else ''})\n")
+    if d["parameters"]:
+        w("parameters   " + ", ".join(f"{k} = {fmt(v)}" for k, v in d["parameters"].items())
+          + "\n")
+    w(f"gravity      {_text(d['gravity'])}\n")
+    w(f"bodies ({len(d['bodies'])})\n")
+    for b in d["bodies"]:
+        if b["massless"]:
+            w(f"  {b['name']:<14} massless frame\n")
+            continue
+        I = np.array(b["inertia"])
+        inertia = (f"diag{_text(np.diag(I).tolist())}" if not np.any(I - np.diag(np.diag(I)))
+                   else _text(I.tolist()))
+        w(f"  {b['name']:<14} mass {fmt(b['mass'])}, com {_text(b['com'])}, "
+          f"inertia about com {inertia}\n")
+    w(f"joints ({len(d['joints'])})\n")
+    for j in d["joints"]:
+        extra = ""
+        if "axis" in j:
+            extra += f" axis {_text(j['axis'])}"
+        if "sequence" in j:
+            extra += f" {j['sequence']}"
+        if "position" in j:
+            extra += f" at {_text(j['position'])}"
+        what = (f"driven: {j['coordinates'][0]} = {j['drive']}" if j["driven"]
+                else ("coordinates " + ", ".join(j["coordinates"]) if j["coordinates"]
+                      else "no coordinates"))
+        w(f"  {j['name']:<14} {j['kind']}{extra}, {j['parent']} -> {j['child']}; {what}\n")
+    w(f"coordinates  {', '.join(d['coordinates']) or '(none)'}\n")
+    w(f"speeds       {', '.join(d['speeds']) or '(none)'}\n")
+    w(f"degrees of freedom  {d['dof']}\n")
+    w("drives       " + ("; ".join(f"{x['joint']}: {x['coordinate']} = {x['expression']}"
+                                   for x in d["drives"]) or "none") + "\n")
+    w(f"loads ({len(d['loads'])})\n")
+    for ld in d["loads"]:
+        parts = [f"{k} {_text(ld[k])}" for k in ("force", "moment") if ld[k] is not None]
+        w(f"  {ld['name']:<14} on {ld['body']}: {', '.join(parts)} ({ld['frame']} axes)\n")
+    w(f"events ({len(d['events'])})\n")
+    for e in d["events"]:
+        w(f"  {e['name']:<14} {e['condition']}  ({e['direction']}"
+          f"{', terminal' if e['terminal'] else ''})\n")
+    w("initial      " + (", ".join(f"{k} = {fmt(v)}" for k, v in d["initial"].items())
+                         or "(none)") + "\n")
+    s = d["simulation"]
+    w("simulation   " + ", ".join(f"{k} = {fmt(v) if not isinstance(v, str) else v}"
+                                  for k, v in s.items() if v is not None) + "\n")
+    o = d["outputs"]
+    outs = []
+    if o["reactions"]:
+        outs.append(f"reactions of {', '.join(o['reactions'])} ({o['reactions_frame']} axes)")
+    if o["energy"]:
+        outs.append("energy")
+    if o["points"]:
+        outs.append("points " + ", ".join(o["points"]))
+    w("outputs      " + ("; ".join(outs) or "state only") + "\n")
+    w(f"warnings ({len(d['warnings'])})\n")
+    for text in d["warnings"]:
+        w(f"  - {text}\n")
+    return 0

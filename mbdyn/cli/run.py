@@ -1,0 +1,93 @@
+"""``mbdyn run MODEL``: simulate a model file; summary, ``--json`` or ``--out DIR``."""
+from __future__ import annotations
+
+import json
+import sys
+
+from ..errors import SimulationError
+from ..io.loader import METHODS
+from ..io.results import summary, write_results
+from ..simulate import FIXED_STEP, INTEGRATORS
+from .common import Progress, add_model_arguments, fmt, load
+
+#: options that are shorthands of --set simulation.KEY=VALUE
+FLAGS = (("simulation.t_end", "--t-end"), ("simulation.method", "--method"),
+         ("simulation.integrator", "--integrator"), ("simulation.rtol", "--rtol"),
+         ("simulation.atol", "--atol"), ("simulation.dt", "--dt"))
+
+
+def register(subparsers):
+    p = subparsers.add_parser(
+        "run", help="simulate a model file",
+        description="Simulate a model file with its [simulation] settings; options "
+                    "override them (after --case and --set).")
+    add_model_arguments(p)
+    p.add_argument("--t-end", metavar="T", help="end time (s)")
+    p.add_argument("--method", choices=METHODS, help="formulation: " + ", ".join(METHODS))
+    p.add_argument("--integrator", choices=INTEGRATORS, metavar="NAME",
+                   help="one of " + ", ".join(INTEGRATORS) + " (euler, semi-implicit-euler "
+                        "and rk4 are fixed-step and need --dt)")
+    p.add_argument("--rtol", metavar="R", help="relative tolerance (adaptive integrators)")
+    p.add_argument("--atol", metavar="A", help="absolute tolerance (adaptive integrators)")
+    p.add_argument("--dt", metavar="H", help="step size (fixed-step integrators)")
+    p.add_argument("--out", metavar="DIR", help="write STEM.csv (named columns) and "
+                                                "STEM.json (metadata) into DIR")
+    p.add_argument("--json", action="store_true",
+                   help="print one JSON object (the summary) and nothing else on stdout")
+    p.set_defaults(func=run)
+
+
+def run(args):
+    scene = load(args, FLAGS)
+    progress = Progress(scene.settings.get("t_end") or 0.0)
+    try:
+        result = scene.simulate(progress=progress)
+    except SimulationError as exc:
+        progress.close()
+        if args.out and exc.result is not None and len(exc.result.t):
+            write_results(args.out, scene, exc.result, status="failed", error=str(exc))
+        if scene.settings["integrator"] in FIXED_STEP:
+            raise SimulationError(f"{exc} (with the fixed-step integrator "
+                                  f"{scene.settings['integrator']!r} this may be the scheme, "
+                                  "not the model: try a smaller --dt or an adaptive "
+                                  "--integrator such as DOP853)", exc.result) from exc
+        raise
+    progress.close()
+    paths = write_results(args.out, scene, result) if args.out else ()
+    if args.json:
+        sys.stdout.write(json.dumps(summary(scene, result)) + "\n")
+    else:
+        report(scene, result, paths)
+    return 0
+
+
+def report(scene, result, paths):
+    s = summary(scene, result)
+    st = result.stats
+    out = sys.stdout
+    case = f", case {scene.case}" if scene.case else ""
+    out.write(f"{scene.name} ({scene.path}{case})\n")
+    step = f", dt = {fmt(st.get('dt'))}" if st.get("dt") and st.get("integrator") in (
+        "euler", "semi-implicit-euler", "rk4") else \
+        f", rtol = {fmt(st.get('rtol'))}, atol = {fmt(st.get('atol'))}"
+    out.write(f"  integrator {s['stats']['integrator']}, method {s['stats']['method']}{step}\n")
+    out.write(f"  t = {fmt(result.t[0])} .. {fmt(s['t_final'])} s: {s['stats']['steps']} steps, "
+              f"{s['stats']['rhs_evaluations']} right-hand sides, "
+              f"{s['stats']['wall_time_s']:.3g} s wall time\n")
+    terminal = {e.name: e.terminal for e in scene.events}
+    if s["events"]:
+        for e in s["events"]:
+            tag = " (terminal: the run stops)" if terminal.get(e["name"]) else ""
+            out.write(f"  event {e['name']} at t = {fmt(e['t'])} s{tag}\n")
+    elif scene.events:
+        out.write("  events: none occurred\n")
+    out.write("  final state:\n")
+    names = list(s["q"].items()) + list(s["u"].items())
+    width = max((len(n) for n, _ in names), default=1)
+    for n, v in names:
+        out.write(f"    {n:<{width}} = {fmt(v)}\n")
+    if s["energy"]:
+        e0, e1 = s["energy"]["initial"], s["energy"]["final"]
+        out.write(f"  energy T + V: initial {fmt(e0)} J, final {fmt(e1)} J\n")
+    for p in paths:
+        out.write(f"  wrote {p}\n")

@@ -1,0 +1,180 @@
+"""Results export: the ``--json`` summary, and CSV + JSON metadata files written atomically.
+
+Every file is written to a temporary file in the target directory, flushed to disk and
+then renamed over the final name with ``os.replace`` -- an interrupted run never leaves a
+half-written file behind (either the old file or the complete new one is there).
+"""
+from __future__ import annotations
+
+import datetime
+import io
+import json
+import math
+import os
+import tempfile
+
+import numpy as np
+
+AXES = ("x", "y", "z")
+WRENCH = ("Fx", "Fy", "Fz", "Mx", "My", "Mz")
+
+
+def _float(x):
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def summary(scene, result):
+    """The ``mbdyn run --json`` object::
+
+        {"model": str, "case": str|null, "t_final": float, "q": {name: float},
+         "u": {name: float}, "events": [{"name": str, "t": float}],
+         "energy": {"initial": float, "final": float}|null,
+         "stats": {"integrator": str, "method": str, "steps": int,
+                   "rhs_evaluations": int, "wall_time_s": float}}
+    """
+    model = scene.model
+    energy = None
+    if result.energy is not None and len(result.t):
+        total = result.energy["total"]
+        energy = {"initial": _float(total[0]), "final": _float(total[-1])}
+    st = result.stats
+    return {
+        "model": scene.name,
+        "case": scene.case,
+        "t_final": _float(result.t[-1]),
+        "q": {n: _float(v) for n, v in zip(model.coordinates, result.q[-1])},
+        "u": {n: _float(v) for n, v in zip(model.speeds, result.u[-1])},
+        "events": [{"name": str(n), "t": _float(t)} for n, t in result.events],
+        "energy": energy,
+        "stats": {"integrator": str(st.get("integrator")), "method": str(st.get("method")),
+                  "steps": int(st.get("steps", 0)),
+                  "rhs_evaluations": int(st.get("rhs_evaluations", 0)),
+                  "wall_time_s": _float(st.get("wall_time_s", 0.0))},
+    }
+
+
+def reaction_series(scene, result):
+    """``{joint: (n, 6)}`` of the requested reactions (``[outputs] reactions``), in world
+    components or, with ``reactions_frame = "child"``, in the child frame's components."""
+    if result.reactions is None:
+        return {}
+    wanted = scene.outputs["reactions"]
+    out = {j: np.array(result.reactions[j]) for j in wanted if j in result.reactions}
+    if scene.outputs["reactions_frame"] == "child" and out:
+        model = scene.model
+        child = {j: model.frame_index(model.joint(j).child) for j in out}
+        for k in range(len(result.t)):
+            kin = model.kinematics(result.q[k], result.u[k], t=result.t[k])
+            for j, arr in out.items():
+                RT = kin.R[child[j]].T
+                arr[k, :3] = RT @ arr[k, :3]
+                arr[k, 3:] = RT @ arr[k, 3:]
+    return out
+
+
+def columns(scene, result):
+    """``(names, table)``: the named columns of the results CSV."""
+    names = ["t"] + list(result.coordinates) + list(result.speeds)
+    cols = [result.t[:, None], result.q, result.u]
+    if result.energy is not None:
+        for key in ("kinetic", "potential", "total"):
+            names.append(f"energy_{key}")
+            cols.append(np.asarray(result.energy[key])[:, None])
+    for j, arr in reaction_series(scene, result).items():
+        names.extend(f"reaction_{j}_{c}" for c in WRENCH)
+        cols.append(arr)
+    if result.drive_efforts:
+        for j, arr in result.drive_efforts.items():
+            names.append(f"effort_{j}")
+            cols.append(np.asarray(arr)[:, None])
+    if result.points:
+        for p, arr in result.points.items():
+            names.extend(f"point_{p}_{a}" for a in AXES)
+            cols.append(np.asarray(arr))
+    return names, np.hstack([np.asarray(c, dtype=float).reshape(len(result.t), -1)
+                             for c in cols])
+
+
+def atomic_write(path, text):
+    """Write ``text`` to ``path`` via a temporary file and ``os.replace``."""
+    directory = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", suffix=".tmp",
+                               dir=directory)
+    try:
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
+            fh.write(text)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
+def output_stem(scene):
+    """``top_a`` for model file ``top.toml`` and case ``a``."""
+    stem = os.path.splitext(os.path.basename(scene.path))[0]
+    return f"{stem}_{scene.case}" if scene.case else stem
+
+
+def write_results(directory, scene, result, status="ok", error=None, extra=None):
+    """Write ``STEM.csv`` (named columns) and ``STEM.json`` (metadata) into ``directory``
+    (created if needed); returns the two paths.  The JSON is written last, so its
+    presence means the CSV beside it is complete."""
+    os.makedirs(directory, exist_ok=True)
+    stem = output_stem(scene)
+    csv_path = os.path.join(directory, stem + ".csv")
+    json_path = os.path.join(directory, stem + ".json")
+    names, table = columns(scene, result)
+    buf = io.StringIO()
+    buf.write(",".join(names) + "\n")
+    np.savetxt(buf, table, delimiter=",", fmt="%.15g")
+    atomic_write(csv_path, buf.getvalue())
+    meta = summary(scene, result)
+    meta.update({
+        "status": status,
+        "error": error,
+        "file": os.path.abspath(scene.path),
+        "description": scene.description,
+        "parameters": scene.parameters,
+        "initial": scene.initial_state,
+        "simulation": {k: v for k, v in scene.settings.items()},
+        "outputs": {"reactions": list(scene.outputs["reactions"]),
+                    "reactions_frame": scene.outputs["reactions_frame"],
+                    "energy": scene.outputs["energy"],
+                    "points": {k: {"frame": f, "offset": list(o)}
+                               for k, (f, o) in scene.outputs["points"].items()}},
+        "warnings": list(scene.warnings),
+        "csv": os.path.basename(csv_path),
+        "columns": names,
+        "samples": int(len(result.t)),
+        "stats_all": {k: _jsonable(v) for k, v in result.stats.items()},
+        "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+    })
+    if extra:
+        meta.update(extra)
+    atomic_write(json_path, json.dumps(meta, indent=2, default=_jsonable) + "\n")
+    return csv_path, json_path
+
+
+def _jsonable(v):
+    if isinstance(v, dict):
+        return {str(k): _jsonable(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_jsonable(x) for x in v]
+    if isinstance(v, (np.integer,)):
+        return int(v)
+    if isinstance(v, (float, np.floating)):
+        return _float(v)
+    if isinstance(v, np.ndarray):
+        return _jsonable(v.tolist())
+    if v is None or isinstance(v, (str, int, bool)):
+        return v
+    return str(v)
