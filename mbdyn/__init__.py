@@ -12,10 +12,11 @@ from .errors import (ModelError, ModelWarning, NonFiniteError, SimulationError,
 from .model import GROUND, System
 from .simulate import FIXED_STEP, INTEGRATORS, Event, Result, simulate
 from .io import ModelFileError, Scene, load_model
+from .symbolic import derive
 
 __version__ = "0.1.0"
 
 __all__ = ["System", "Model", "Kinematics", "Result", "Event", "simulate", "inertia", "t",
            "GROUND", "INTEGRATORS", "FIXED_STEP", "ModelError", "ModelWarning",
            "NonFiniteError", "SimulationError", "SingularityWarning",
-           "SingularMassMatrixError", "load_model", "Scene", "ModelFileError"]
+           "SingularMassMatrixError", "load_model", "Scene", "ModelFileError", "derive"]

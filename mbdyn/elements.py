@@ -320,8 +320,8 @@ def make_joint(name, kind, parent, child, *, axis=None, position=(0, 0, 0), orie
     expressions of ``parameters`` (kept in ``symbolic``)."""
     element = f"joint {name!r}"
     parameters = parameters or {}
-    raw = {"axis": axis, "position": position, "orientation": orientation}
-    symbolic = {k: v for k, v in raw.items() if has_symbols(v)}
+    raw = {"axis": axis, "position": position, "orientation": orientation, "drive": drive}
+    symbolic = {k: v for k, v in raw.items() if not callable(v) and has_symbols(v)}
     if not isinstance(axis, str):
         axis = numeric(axis, parameters, element, "axis")
     position = numeric(position, parameters, element, "position")

@@ -121,15 +121,11 @@ class Result:
             scale = max(abs(E0), np.abs(TV).max(), 1e-300)
             self.stats["energy_drift"] = float(np.abs(self.energy["total"] - E0).max() / scale)
         if points:
-            self.points = {}
-            for pname, (frame, offset) in points.items():
-                i = model.frame_index(frame)
-                off = np.asarray(offset, dtype=float)
-                traj = np.empty((n, 3))
-                for k in range(n):
-                    kin = model.kinematics(self.q[k], self.u[k], t=self.t[k])
-                    traj[k] = kin.r[i] + kin.R[i] @ off
-                self.points[pname] = traj
+            names = list(points)
+            specs = [points[p] for p in names]
+            traj = np.array([model.point_positions(self.q[k], specs, self.t[k])
+                             for k in range(n)]).reshape(n, len(names), 3)
+            self.points = {p: traj[:, k] for k, p in enumerate(names)}
         return self
 
 
@@ -198,9 +194,20 @@ class _RightHandSide:
         self.method = method
         self.nq = model.nq
         self.evaluations = 0
+        self.symbolic = None
+        if method == "symbolic":        # generated from the closed-form equations
+            from .symbolic import compiled_rhs
+            self.symbolic = compiled_rhs(model)
+
+    def accelerations(self, q, u, t):
+        if self.symbolic is not None:
+            return self.symbolic.accelerations(q, u, t)
+        return self.model.forward_dynamics(q, u, t, method=self.method)
 
     def __call__(self, t, y):
         self.evaluations += 1
+        if self.symbolic is not None:
+            return self.symbolic(t, y)  # a new array every call
         q = y[:self.nq]
         u = y[self.nq:]
         out = np.empty_like(y)      # a fresh array: scipy's solvers keep what they are given
@@ -218,8 +225,9 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator="RK45", rtol=
 
     ``q0``/``u0``: arrays or ``{name: value}`` over the defaults (zero, identity
     quaternions).  ``integrator``: one of ``INTEGRATORS``; the fixed-step ones need ``dt``.
-    ``method``: ``"jourdain"`` or ``"newton-euler"``.  ``events``: ``Event``s.  ``t_eval``:
-    output times (default every accepted step).  ``outputs``: any of ``"reactions"``,
+    ``method``: ``"jourdain"``, ``"newton-euler"`` or ``"symbolic"`` (the closed-form
+    equations compiled by ``mbdyn.symbolic.compiled_rhs``).  ``events``: ``Event``s.
+    ``t_eval``: output times (default every accepted step).  ``outputs``: any of ``"reactions"``,
     ``"energy"``; ``points``: ``{name: (frame, offset)}``.  ``progress``: optional callable
     ``progress(t)`` called after each step.  ``singularity_threshold``: stop when an
     Euler-angle joint comes this close to its singularity (see ``Model.euler_singularity``).
@@ -237,8 +245,9 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator="RK45", rtol=
         model = model.compile()           # a System: compile it here
     if integrator not in INTEGRATORS:
         raise ModelError(f"unknown integrator {integrator!r}; use one of {', '.join(INTEGRATORS)}")
-    if method not in ("jourdain", "newton-euler"):
-        raise ModelError(f"unknown method {method!r}; use 'jourdain' or 'newton-euler'")
+    if method not in ("jourdain", "newton-euler", "symbolic"):
+        raise ModelError(f"unknown method {method!r}; use 'jourdain', 'newton-euler' or "
+                         "'symbolic'")
     t0, t_end = float(t0), float(t_end)
     if not t_end > t0:
         raise ModelError(f"t_end ({t_end}) must be greater than t0 ({t0})")
@@ -404,7 +413,7 @@ def _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events, 
     return np.array(ts), np.array(ys), found, info
 
 
-def _fixed_chunks(rhs, integrator, t0, t_end, y0, dt, compiled):
+def _fixed_chunks(rhs, integrator, t0, t_end, y0, dt, compiled, events=()):
     """Yield ``(times, states, failure)`` stretches of the fixed-step motion after ``y0``.
 
     Compiled path (``kernels.integrators``) when ``compiled``; else one Python step at a
@@ -423,7 +432,9 @@ def _fixed_chunks(rhs, integrator, t0, t_end, y0, dt, compiled):
     if compiled:
         from .kernels.integrators import SCHEMES, STAGES, fixed_step_loop
         args = model.loop_arguments()
-        chunk = 2000
+        # stretches between checks of events and singularities: short when there are
+        # some (a terminal event wastes at most a stretch), long otherwise
+        chunk = 200 if (events or model._euler_middle) else 2000
         for h, ts in plan:
             for lo in range(0, len(ts), chunk):
                 tk = ts[lo:lo + chunk]
@@ -484,7 +495,7 @@ def _run_fixed(rhs, integrator, t0, t_end, y0, dt, events, t_eval, progress, mon
     steps = 0
     stop = False
     for times, states, chunk_failure in _fixed_chunks(rhs, integrator, t0, t_end, y0, dt,
-                                                      compiled):
+                                                      compiled, events):
         for t_new, y_new in zip(times, states):
             failure = monitor.check(t_new, y_new)
             if failure:
@@ -534,7 +545,7 @@ def _fixed_step(rhs, integrator, t, y, h, nq):
     if integrator == "semi-implicit-euler":
         q, u = y[:nq], y[nq:]
         rhs.evaluations += 1
-        u_new = u + h * model.forward_dynamics(q, u, t, method=rhs.method)
+        u_new = u + h * rhs.accelerations(q, u, t)
         q_new = q + h * model.coordinate_rates(q, u_new)
         return np.concatenate([q_new, u_new])
     if integrator == "implicit-midpoint":

@@ -55,10 +55,15 @@ def exact(x, snap=0.0):
     mantissa = text.split("e")[0].replace("-", "").replace(".", "").lstrip("0")
     if len(mantissa) <= 10:
         return sympy.Rational(text)
-    guess = sympy.nsimplify(x, [sympy.pi], tolerance=1e-14 * max(1.0, abs(x)))
-    if (guess.is_number and sympy.count_ops(guess) <= 8
-            and abs(float(guess) - x) <= 4e-16 * max(1.0, abs(x))):
+    tol = 4e-16 * max(1.0, abs(x))
+    sign = 1 if x > 0 else -1
+    square = sympy.Rational(x * x).limit_denominator(1000)          # sqrt(2)/2, sqrt(3)/2
+    guess = sign * sympy.sqrt(square)
+    if abs(float(guess) - x) <= tol:
         return guess
+    turns = sympy.Rational(x / math.pi).limit_denominator(360)        # angles: pi/6, 2*pi/3
+    if abs(float(turns) * math.pi - x) <= tol:
+        return turns * sympy.pi
     return sympy.Float(x)
 
 

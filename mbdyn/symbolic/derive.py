@@ -1,0 +1,231 @@
+"""``derive``: the equations of motion of a model in closed form, by one of three methods.
+
+    d = mb.derive(model, method="newton-euler", solve=True)
+    d.mass_matrix, d.forcing          # M(q), f(q, u, t) of M u' = f (sympy matrices)
+    d.accelerations                   # {speed name: expression of u'} (solve=True)
+    d.reactions                       # {joint: [Fx, Fy, Fz, Mx, My, Mz]} (newton-euler, solve)
+    d.steps()                         # the derivation, step by step, as the textbook does it
+    print(d.to_text(steps=True))      # or to_latex(), to_markdown(), to_dict() / to_json()
+
+Reactions are the force and the moment the parent exerts on the child at the child frame's
+origin, in the child frame's own components (``frames="own"``, the default) or in inertial
+components (``frames="inertial"``).
+"""
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass, field
+
+import sympy
+
+from ..errors import ModelError
+from .methods import FORMULATIONS, METHODS
+from .simplify import (MODES, finish_matrix, operations, operations_after_cse,
+                       tree_size)
+
+#: results (M and f together) up to this many nodes get the final tidying (``finish``)
+FINISH_BUDGET = 5000
+from .solve import solve_linear, substitute_rates
+from .walk import FRAMES, Walk
+
+
+def _as_model(model_or_system):
+    from ..compile import Model
+    if isinstance(model_or_system, Model):
+        return model_or_system
+    if hasattr(model_or_system, "compile") and hasattr(model_or_system, "add_joint"):
+        return model_or_system.compile()
+    if hasattr(model_or_system, "model"):          # a loaded scene
+        return model_or_system.model
+    raise ModelError(f"derive needs a System, a compiled Model or a loaded scene, got "
+                     f"{type(model_or_system).__name__}")
+
+
+def _quotient(num, den, limit=3000):
+    """``num / den`` with the factors they share cancelled (when they are small enough for
+    ``sympy.cancel`` to be quick)."""
+    if den == 1:
+        return num
+    from .simplify import tree_size
+    if tree_size(num) + tree_size(den) > limit:
+        return num / den
+    n, d = sympy.factor_terms(num), sympy.factor_terms(den)
+    g = sympy.gcd_terms(sympy.Integer(1) * n / d)
+    try:
+        c = sympy.cancel(num / den)
+    except Exception:
+        c = g
+    return min((g, c, num / den), key=tree_size)
+
+
+@dataclass
+class Derivation:
+    """The equations of motion of a model by one method (sympy objects); see ``derive``."""
+    model: object
+    method: str
+    frames: str
+    simplify: str
+    walk: Walk
+    equations: object
+    mass_matrix: sympy.Matrix
+    forcing: sympy.Matrix
+    accelerations: dict | None = None
+    reactions: dict | None = None
+    denominator: sympy.Expr | None = None
+    stats: dict = field(default_factory=dict)
+
+    # ------------------------------------------------------------------ basic views
+    @property
+    def symbols(self):
+        return self.walk.sym
+
+    @property
+    def coordinates(self):
+        return tuple(self.model.coordinates)
+
+    @property
+    def speeds(self):
+        return tuple(self.model.speeds)
+
+    @property
+    def rates(self):
+        """Symbols of the speed rates ``u'`` in ``speeds`` order."""
+        return tuple(self.walk.sym.ud)
+
+    @property
+    def kinematic_equations(self):
+        """``{coordinate symbol: rate expression}``: ``q' = N(q) u``."""
+        return dict(self.walk.qdot)
+
+    def equations_of_motion(self):
+        """The rows of ``M u' = f`` as ``sympy.Eq`` (left: ``M u'``, right: ``f``)."""
+        ud = sympy.Matrix(self.rates)
+        lhs = self.mass_matrix * ud
+        return [sympy.Eq(lhs[k], self.forcing[k]) for k in range(len(ud))]
+
+    def names(self):
+        """``{name: Symbol}`` of every parameter, coordinate, speed, rate and ``t``."""
+        return dict(self.walk.sym.table)
+
+    # ------------------------------------------------------------------ numbers
+    def numeric(self, what="mass_matrix"):
+        """A function ``(q, u, t=0, parameters=None)`` -> numpy array of ``mass_matrix``,
+        ``forcing``, ``accelerations`` (in ``speeds`` order) or ``reactions`` (joints in
+        model order, six components each) -- for checks, not for speed (see ``codegen``)."""
+        import numpy as np
+        from .evaluate import evaluate
+        sym = self.walk.sym
+        if what == "accelerations":
+            if self.accelerations is None:
+                raise ModelError("derive(..., solve=True) first")
+            expr = sympy.Matrix([self.accelerations[s] for s in self.speeds])
+        elif what == "reactions":
+            if self.reactions is None:
+                raise ModelError("derive(..., method='newton-euler', solve=True) first")
+            expr = sympy.Matrix([[e for e in self.reactions[j]] for j in self.model.joints])
+        else:
+            expr = getattr(self, what)
+        shape = expr.shape
+        flat = list(expr)
+        params = dict(self.model.parameters)
+
+        def evaluate_at(q, u, t=0.0, parameters=None):
+            vals = {sym.t: float(t)}
+            vals.update({s: float(x) for s, x in zip(sym.q, q)})
+            vals.update({s: float(x) for s, x in zip(sym.u, u)})
+            p = dict(params, **(parameters or {}))
+            vals.update({s: float(p[n]) for n, s in sym.params.items()})
+            return np.array(evaluate(flat, vals), dtype=float).reshape(shape).squeeze()
+        return evaluate_at
+
+    # ------------------------------------------------------------------ reports
+    def steps(self):
+        """The derivation as the textbook writes it: a list of ``Step``."""
+        from .steps import build_steps
+        return build_steps(self)
+
+    def to_dict(self, steps=False):
+        """The ``mbdyn eom --format json`` object (expression strings parseable by
+        ``sympy.sympify`` with the model's names as symbols)."""
+        from .report import as_dict
+        return as_dict(self, steps=steps)
+
+    def to_json(self, steps=False, indent=2):
+        return json.dumps(self.to_dict(steps=steps), indent=indent)
+
+    def to_text(self, steps=False):
+        from .report import as_text
+        return as_text(self, steps=steps)
+
+    def to_latex(self, steps=False):
+        from .report import as_latex
+        return as_latex(self, steps=steps)
+
+    def to_markdown(self, steps=False):
+        from .report import as_markdown
+        return as_markdown(self, steps=steps)
+
+    def __repr__(self):
+        return (f"<Derivation {self.model.name!r} by {self.method}: {len(self.speeds)} speeds, "
+                f"{self.stats.get('operations', '?')} operations>")
+
+
+def derive(model_or_system, method="jourdain", *, frames="own", simplify="compact",
+           solve=False, measure=True):
+    """Derive the equations of motion of a model in closed form.
+
+    ``method``: ``"newton-euler"`` (per-body equations with the joint reactions as unknowns),
+    ``"jourdain"`` (``M = sum J^T m J``, reactions eliminated) or ``"lagrange"`` (from the
+    kinetic and potential energies and the generalized forces of the loads).  ``frames``:
+    write each body's vectors in its own frame (``"own"``, compact) or in the inertial
+    frame (``"inertial"``).  ``simplify``: ``"compact"`` (default), ``"expand"``,
+    ``"none"`` or ``"trigsimp"`` (see ``mbdyn.symbolic.simplify``).  ``solve``: also solve
+    for the accelerations (and, for newton-euler, every reaction component) in closed form
+    -- practical for a few degrees of freedom.  ``measure``: count the operations of ``M``
+    and ``f`` before and after cse into ``stats`` (slow for very large expressions).
+    """
+    if method not in METHODS:
+        raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")
+    if frames not in FRAMES:
+        raise ModelError(f"unknown frames {frames!r}; use one of {', '.join(FRAMES)}")
+    if simplify not in MODES:
+        raise ModelError(f"unknown simplify {simplify!r}; use one of {', '.join(MODES)}")
+    model = _as_model(model_or_system)
+    start = time.perf_counter()
+    walk = Walk(model, frames=frames, simplify=simplify)
+    t_walk = time.perf_counter()
+    eq = FORMULATIONS[method](walk)
+    size = sum(tree_size(e) for e in eq.M) + sum(tree_size(e) for e in eq.f)
+    if size <= FINISH_BUDGET:               # small results: expand, reduce and tidy them
+        M = finish_matrix(eq.M, simplify, units=walk.units)
+        f = finish_matrix(eq.f, simplify, units=walk.units)
+    else:                                   # large ones stay in the walk's nested form
+        M, f = eq.M, eq.f
+    t_eq = time.perf_counter()
+    d = Derivation(model, method, frames, simplify, walk, eq, M, f)
+    if solve:
+        nums, den = solve_linear(M, f, simplify, walk.units)
+        d.denominator = den
+        d.accelerations = {s: _quotient(n, den) for s, n in zip(model.speeds, nums)}
+        if method == "newton-euler":
+            d.reactions = {}
+            for joint in model.joints:
+                AF, bF, AM, bM = eq.details["reactions"].linear(joint)
+                comps = []
+                for A, b in ((AF, bF), (AM, bM)):
+                    for r in range(3):
+                        if b[r] == 0 and all(a == 0 for a in A[r, :]):
+                            comps.append(sympy.Integer(0))
+                            continue
+                        num = substitute_rates(A[r, :], b[r], nums, den, simplify,
+                                               walk.units)
+                        comps.append(_quotient(num, den))
+                d.reactions[joint] = comps
+    end = time.perf_counter()
+    d.stats = {"derive_s": end - start, "walk_s": t_walk - start, "equations_s": t_eq - t_walk,
+               "solve_s": end - t_eq}
+    if measure:
+        d.stats["operations"] = operations(M) + operations(f)
+        d.stats["operations_after_cse"] = operations_after_cse([M, f])
+    return d

@@ -1,0 +1,406 @@
+"""The kinematic walk with sympy: steps 1-11 of the textbook for every frame of a model.
+
+For each frame, parents first: the transformation matrix from its parent, the position
+vectors, the absolute angular velocity and acceleration, the velocity and acceleration of
+its origin and of its centre of mass, the Jacobians of rotation and translation, and the
+applied forces and moments reduced to the centre of mass -- the same quantities as
+``mbdyn.kernels.kinematics`` computes numerically, as expressions.
+
+Every vector of frame ``i`` is written in one *basis*: with ``frames="own"`` (default, the
+textbook's advice) in frame ``i``'s own axes, where the body's inertia tensor is constant and
+the expressions are shortest; with ``frames="inertial"`` in the inertial axes (the "one
+frame" style whose expressions grow with every sum of angles).  The recursion is the same::
+
+    w_i   = X w_p + X_c w_rel
+    al_i  = X al_p + (X w_p) x (X_c w_rel) + X_c d/dt(w_rel)
+    v_i   = X v_p + (X w_p) x rho + v_rel
+    a_i   = X a_p + (X al_p) x rho + (X w_p) x ((X w_p) x rho) + 2 (X w_p) x v_rel + a_rel
+    v_G   = v_i + w_i x c,     a_G = a_i + al_i x c + w_i x (w_i x c)
+
+with ``X`` the change of basis from the parent's basis (``T`` of the joint for ``own``,
+identity for ``inertial``), ``X_c`` from the child's own axes (identity / ``R_i``), and
+``rho``, ``v_rel``, ``a_rel`` the joint's offset and relative motion in the new basis.
+
+Conventions follow ``mbdyn.kernels.joints``: a joint frame J0 is fixed in the parent at
+``position`` with orientation ``C`` (``P s = C J0 s``); ``Rrel`` maps child to J0
+components; the textbook's transformation matrix is ``T = (C Rrel)^T`` (``B s = T P s``).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import sympy
+
+from ..errors import ModelError
+from .simplify import compact, compact_matrix, diff, free_symbols
+from .symbols import (Symbols, axis_vector, canonical, cross, exact, exact_matrix,
+                      exact_vector, orientation_matrix, quaternion_matrix,
+                      rotation_about_axis, rotation_about_coordinate_axis)
+
+FRAMES = ("own", "inertial")
+
+E3 = sympy.eye(3)
+Z3 = sympy.zeros(3, 1)
+
+
+@dataclass
+class FrameMotion:
+    """Everything the walk knows about one frame (vectors in ``basis`` components)."""
+    index: int
+    name: str
+    joint: object            # the Joint record
+    parent: str
+    basis: str               # "B<i>" label of the components used, or "I"
+    T: sympy.Matrix          # joint transformation matrix B s = T P s
+    Rrel: sympy.Matrix       # J0 <- B
+    C: sympy.Matrix          # P <- J0
+    rho_p: sympy.Matrix      # parent origin -> this origin, parent components
+    com: sympy.Matrix        # origin -> centre of mass, own components
+    mass: sympy.Expr
+    inertia: sympy.Matrix    # about the centre of mass, own axes
+    w_rel: sympy.Matrix      # relative angular velocity, own components
+    omega: sympy.Matrix
+    alpha: sympy.Matrix
+    r: sympy.Matrix          # position of the origin from the inertial origin
+    v: sympy.Matrix
+    a: sympy.Matrix
+    r_G: sympy.Matrix
+    v_G: sympy.Matrix
+    a_G: sympy.Matrix
+    JR: sympy.Matrix         # d omega / d u   (3 x nu)
+    JT: sympy.Matrix         # d v_G / d u     (3 x nu)
+    gravity: sympy.Matrix    # gravitational acceleration in basis components
+    X_child: sympy.Matrix    # basis <- own axes
+    w_rel_basis: sympy.Matrix = None   # relative angular velocity of the joint, basis comps
+    v_rel_basis: sympy.Matrix = None   # relative velocity of the joint, basis comps
+    force: sympy.Matrix = None     # applied force (gravity + loads), basis components
+    moment: sympy.Matrix = None    # applied moment about the centre of mass
+    loads: list = field(default_factory=list)   # (name, F, N, point) basis comps / own point
+    children: list = field(default_factory=list)
+
+    @property
+    def has_inertia(self):
+        return self.mass != 0 or any(e != 0 for e in self.inertia)
+
+    @property
+    def inertia_basis(self):
+        X = self.X_child
+        return self.inertia if X is E3 else X * self.inertia * X.T
+
+    @property
+    def com_basis(self):
+        return self.com if self.X_child is E3 else self.X_child * self.com
+
+
+def _joint_values(joint, sym, qi, ui):
+    """Coordinates, speeds and speed rates of a joint: symbols, or its drive's expressions."""
+    if joint.drive is not None:
+        expr = joint.symbolic.get("drive") if isinstance(joint.symbolic, dict) else None
+        if expr is None:
+            expr = joint.drive.expression
+        if expr is None:
+            raise ModelError(f"joint {joint.name!r}: its drive is given as Python functions; a "
+                             "symbolic derivation needs it as a sympy expression of mb.t "
+                             "(e.g. drive=Omega*mb.t)")
+        expr = canonical(sympy.sympify(expr), sym.table)
+        return [expr], [expr.diff(sym.t)], [expr.diff(sym.t, 2)], True
+    if not joint.nu:
+        return [], [], [], False
+    return (sym.q[qi:qi + joint.nq], sym.u[ui:ui + joint.nu], sym.ud[ui:ui + joint.nu], False)
+
+
+def joint_motion(joint, axis, qj, uj):
+    """Symbolic ``Rrel`` (J0 <- B), offset ``d`` (J0), relative angular velocity (B comps)
+    and relative velocity (J0 comps) of a joint; see ``mbdyn.kernels.joints``."""
+    kind = joint.kind
+    if kind == "fixed":
+        return E3, Z3, Z3, Z3
+    if kind == "revolute":
+        return rotation_about_axis(axis, qj[0]), Z3, axis * uj[0], Z3
+    if kind == "prismatic":
+        return E3, axis * qj[0], Z3, axis * uj[0]
+    if kind == "euler":
+        s0, s1, s2 = joint.sequence
+        R0 = rotation_about_coordinate_axis(s0, qj[0])
+        R1 = rotation_about_coordinate_axis(s1, qj[1])
+        R2 = rotation_about_coordinate_axis(s2, qj[2])
+        e = [E3[:, k] for k in range(3)]
+        w = R2.T * (R1.T * e[s0]) * uj[0] + R2.T * e[s1] * uj[1] + e[s2] * uj[2]
+        return R0 * R1 * R2, Z3, w, Z3
+    if kind == "spherical":
+        return quaternion_matrix(*qj), Z3, sympy.Matrix(uj), Z3
+    if kind == "free":
+        return (quaternion_matrix(*qj[3:7]), sympy.Matrix(qj[0:3]), sympy.Matrix(uj[3:6]),
+                sympy.Matrix(uj[0:3]))
+    raise ModelError(f"joint {joint.name!r}: unknown kind {kind!r}")
+
+
+def _cross_columns(r, A):
+    """``r x`` every column of ``A`` (3 x n)."""
+    out = sympy.zeros(3, A.cols)
+    for k in range(A.cols):
+        a = A[:, k]
+        if any(e != 0 for e in a):
+            out[:, k] = cross(r, a)
+    return out
+
+
+def quaternion_rates(qj, w):
+    """``q' = 1/2 q (x) (0, w)``, ``w`` in child components."""
+    a, b, c, d = qj
+    return [(-b * w[0] - c * w[1] - d * w[2]) / 2, (a * w[0] - d * w[1] + c * w[2]) / 2,
+            (d * w[0] + a * w[1] - b * w[2]) / 2, (-c * w[0] + b * w[1] + a * w[2]) / 2]
+
+
+class Walk:
+    """The symbolic kinematics and applied loads of a compiled model.
+
+    ``frames``: ``"own"`` or ``"inertial"`` (see the module docstring); ``simplify``: one of
+    ``mbdyn.symbolic.simplify.MODES``.  ``motions`` lists a ``FrameMotion`` per frame in
+    topological order; ``qdot`` maps each coordinate symbol to its rate (the kinematic
+    equations ``q' = N(q) u``).
+    """
+
+    def __init__(self, model, frames="own", simplify="compact"):
+        if frames not in FRAMES:
+            raise ModelError(f"unknown frames {frames!r}; use one of {', '.join(FRAMES)}")
+        self.model = model
+        self.frames = frames
+        self.simplify = simplify
+        self.sym = sym = Symbols(model)
+        bodies, joints, loads = model.elements
+        self.bodies, self.joints, self.loads = bodies, joints, loads
+        self.gravity = self._gravity()
+        self.qdot = {}
+        self.u_to_ud = dict(zip(sym.u, sym.ud))
+        self.zero_ud = {s: 0 for s in sym.ud}
+        self.motions = []
+        self.by_name = {}
+        self.joint_values = {}
+        self.units = []                     # unit quaternions: their squares sum to 1
+        qi = ui = 0
+        for i, (body, joint) in enumerate(zip(bodies, joints)):
+            qj, uj, udj, driven = _joint_values(joint, sym, qi, ui)
+            self.joint_values[joint.name] = (qj, uj, udj, driven)
+            if not driven and joint.nu:
+                if joint.kind == "spherical":
+                    self.units.append(tuple(qj))
+                    for s, r in zip(qj, quaternion_rates(qj, uj)):
+                        self.qdot[s] = r
+                elif joint.kind == "free":
+                    self.units.append(tuple(qj[3:]))
+                    for s, r in zip(qj[:3], uj[:3]):
+                        self.qdot[s] = r
+                    for s, r in zip(qj[3:], quaternion_rates(qj[3:], uj[3:])):
+                        self.qdot[s] = r
+                else:
+                    for s, r in zip(qj, uj):
+                        self.qdot[s] = r
+                qi += joint.nq
+                ui += joint.nu
+            m = self._walk_frame(i, body, joint, qj, uj)
+            self.motions.append(m)
+            self.by_name[body.name] = m
+            if joint.parent in self.by_name:
+                self.by_name[joint.parent].children.append(m)
+        self._apply_loads()
+
+    # ------------------------------------------------------------------ helpers
+    def s(self, expr):
+        """Simplify a scalar or matrix with the walk's mode."""
+        if isinstance(expr, sympy.MatrixBase):
+            return compact_matrix(expr, self.simplify, units=self.units)
+        return compact(expr, self.simplify, units=self.units)
+
+    def D(self, expr):
+        """Total time derivative along the motion: ``q' = N(q) u``, ``u' = ud`` (symbols) and
+        explicit ``t`` (drives, loads)."""
+        if isinstance(expr, sympy.MatrixBase):
+            return expr.applyfunc(self.D)
+        if not isinstance(expr, sympy.Basic):
+            return sympy.Integer(0)
+        out = sympy.Integer(0)
+        for s in sorted(free_symbols(expr), key=lambda x: x.name):
+            if s in self.qdot:
+                out += diff(expr, s) * self.qdot[s]
+            elif s in self.u_to_ud:
+                out += diff(expr, s) * self.u_to_ud[s]
+            elif s == self.sym.t:
+                out += diff(expr, s)
+        return out
+
+    def jacobian(self, vec):
+        """``d vec / d u`` over the free speeds (3 x nu)."""
+        u = self.sym.u
+        if not u:
+            return sympy.zeros(vec.rows, 0)
+        return sympy.Matrix(vec.rows, len(u), lambda r, c: diff(vec[r], u[c]))
+
+    def bias(self, expr):
+        """``expr`` at zero speed rates (velocity-product part of an acceleration)."""
+        return expr.xreplace(self.zero_ud)
+
+    def _gravity(self):
+        m = self.model
+        if m.gravity_symbolic is not None:
+            return exact_vector(m.gravity_symbolic, self.sym.table)
+        return exact_vector(m.gravity, self.sym.table)
+
+    def _body_values(self, body):
+        table = self.sym.table
+        sy = body.symbolic if isinstance(body.symbolic, dict) else {}
+        mass = sy.get("mass", body.mass)
+        mass = canonical(mass, table) if isinstance(mass, sympy.Basic) else exact(mass)
+        com = exact_vector(sy.get("com", body.com), table)
+        raw = sy.get("inertia")
+        if raw is None:
+            inertia = exact_matrix(body.inertia, table)
+        else:
+            arr = np.asarray(raw, dtype=object)
+            if arr.shape == (3,):
+                inertia = sympy.diag(*exact_vector(arr, table))
+            elif arr.shape == ():
+                inertia = E3 * canonical(sympy.sympify(raw), table)
+            else:
+                inertia = exact_matrix(arr, table)
+        return mass, com, inertia
+
+    def _joint_geometry(self, joint):
+        table = self.sym.table
+        sy = joint.symbolic if isinstance(joint.symbolic, dict) else {}
+        if "axis" in sy:
+            axis = axis_vector(sy["axis"], table)
+        else:
+            axis = exact_vector(joint.axis, table)
+            if any(a != 0 for a in axis) and not sympy.simplify((axis.T * axis)[0] - 1) == 0:
+                axis = (axis / sympy.sqrt((axis.T * axis)[0])).applyfunc(sympy.nsimplify)
+        position = exact_vector(sy.get("position", joint.position), table)
+        C = orientation_matrix(sy.get("orientation"), joint.orientation, table)
+        return axis, position, C
+
+    # ------------------------------------------------------------------ the walk
+    def _walk_frame(self, i, body, joint, qj, uj):
+        s = self.s
+        axis, position, C = self._joint_geometry(joint)
+        Rrel, d, w_rel, v_rel_j = joint_motion(joint, axis, qj, uj)
+        Rrel = s(Rrel)
+        w_rel = s(w_rel)
+        T = s((C * Rrel).T)
+        rho_p = s(position + C * d)
+        mass, com, inertia = self._body_values(body)
+        parent = self.by_name.get(joint.parent)
+        own = self.frames == "own"
+        if parent is None:                      # the ground: at rest
+            wp = alp = vp = ap = rp = Z3
+            gp = self.gravity
+            Rp = E3
+        else:
+            wp, alp, vp, ap, rp, gp = (parent.omega, parent.alpha, parent.v, parent.a,
+                                       parent.r, parent.gravity)
+            Rp = parent.X_child
+        if own:
+            X = T                                # parent basis -> this basis
+            Xp = T                               # parent's own axes -> this basis
+            Xc = E3                              # own axes -> basis
+        else:
+            X = E3
+            Xp = Rp
+            Xc = s(Rp * C * Rrel)
+        wp_b = s(X * wp)
+        alp_b = s(X * alp)
+        rho = s(Xp * rho_p)
+        w_rel_b = w_rel if Xc is E3 else s(Xc * w_rel)
+        v_rel = s(Xp * (C * v_rel_j))
+        a_rel = s(Xp * (C * self.D(v_rel_j)))
+        omega = s(wp_b + w_rel_b)
+        dw_rel = self.D(w_rel) if Xc is E3 else Xc * self.D(w_rel)
+        alpha = s(alp_b + cross(wp_b, w_rel_b) + dw_rel)
+        r = s(X * rp + rho)
+        v = s(X * vp + cross(wp_b, rho) + v_rel)
+        a = s(X * ap + cross(alp_b, rho) + cross(wp_b, cross(wp_b, rho)) + 2 * cross(wp_b, v_rel)
+              + a_rel)
+        c = com if Xc is E3 else s(Xc * com)
+        r_G = s(r + c)
+        v_G = s(v + cross(omega, c))
+        a_G = s(a + cross(alpha, c) + cross(omega, cross(omega, c)))
+        g = s(X * gp)
+        # Jacobians recursively, as the numeric kernel does: inherit the parent's columns
+        # (rotated into this basis, the translation one moved along rho), add this joint's
+        JR_p = parent.JR if parent is not None else sympy.zeros(3, len(self.sym.u))
+        JO_p = parent.JO if parent is not None else sympy.zeros(3, len(self.sym.u))
+        JR = X * JR_p
+        JO = X * JO_p - _cross_columns(rho, JR)
+        for u in (uj if not self._driven(joint) else ()):
+            col = self.sym.u.index(u)
+            JR[:, col] += w_rel_b.diff(u)
+            JO[:, col] += v_rel.diff(u)
+        JR = self.s(JR)
+        JO = self.s(JO)
+        JT = self.s(JO - _cross_columns(c, JR))
+        basis = f"B{i + 1}" if own else "I"
+        fm = FrameMotion(i, body.name, joint, joint.parent, basis, T, Rrel, C, rho_p, com,
+                         mass, inertia, w_rel, omega, alpha, r, v, a, r_G, v_G, a_G, JR, JT,
+                         g, Xc, w_rel_b, v_rel)
+        fm.JO = JO
+        return fm
+
+    def _driven(self, joint):
+        return self.joint_values[joint.name][3]
+
+    def absolute_T(self, name):
+        """The transformation matrix ``B s = T I s`` of a frame from the inertial frame."""
+        cache = self.__dict__.setdefault("_absT", {})
+        if name not in cache:
+            m = self.by_name[name]
+            parent = m.parent
+            Tp = E3 if parent not in self.by_name else self.absolute_T(parent)
+            cache[name] = self.s(m.T * Tp)
+        return cache[name]
+
+    def to_basis(self, m, vec, in_body):
+        """A load vector given in body (own) or world components, in ``m``'s basis."""
+        if in_body:
+            return vec if m.X_child is E3 else self.s(m.X_child * vec)
+        return self.s(self.absolute_T(m.name) * vec) if self.frames == "own" else vec
+
+    def _load_vector(self, load, what):
+        table = self.sym.table
+        sy = load.symbolic if isinstance(load.symbolic, dict) else {}
+        val = sy.get(what, getattr(load, what))
+        if callable(val):
+            names = ", ".join(self.model.coordinates + self.model.speeds)
+            raise ModelError(f"load {load.name!r}: its {what} is a Python function; a symbolic "
+                             "derivation needs constants or sympy expressions of t and the "
+                             f"coordinates/speeds ({names})")
+        vec = exact_vector(val, table)
+        allowed = set(self.sym.table.values()) - set(self.sym.ud)
+        bad = sorted(s.name for e in vec for s in e.free_symbols if s not in allowed)
+        if bad:
+            raise ModelError(f"load {load.name!r}: its {what} uses {', '.join(bad)}, which are "
+                             "neither parameters, t, coordinates nor speeds of the model")
+        return vec
+
+    def _apply_loads(self):
+        for m in self.motions:
+            m.force = self.s(m.mass * m.gravity)
+            m.moment = sympy.zeros(3, 1)
+        for load in self.loads:
+            m = self.by_name[load.body]
+            F = self.to_basis(m, self._load_vector(load, "force"), load.in_body)
+            N = self.to_basis(m, self._load_vector(load, "moment"), load.in_body)
+            point = exact_vector(load.symbolic.get("point", load.point)
+                                 if isinstance(load.symbolic, dict) else load.point,
+                                 self.sym.table)
+            lever = point - m.com if m.X_child is E3 else m.X_child * (point - m.com)
+            m.loads.append((load.name, F, N, point))
+            m.force = self.s(m.force + F)
+            m.moment = self.s(m.moment + N + cross(lever, F))
+
+    # ------------------------------------------------------------------ for the methods
+    def point_jacobians(self, m, point):
+        """Jacobians of translation of a point fixed on frame ``m`` (own components) and of
+        rotation, basis components."""
+        p = point if m.X_child is E3 else m.X_child * point
+        vP = m.v + cross(m.omega, p)
+        return self.jacobian(vP), m.JR
