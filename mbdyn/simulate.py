@@ -522,7 +522,7 @@ def _run_fixed(rhs, integrator, t0, t_end, y0, dt, events, t_eval, progress, mon
                 break
         if progress is not None:
             progress(t)
-        failure = failure or chunk_failure
+        failure = failure or (None if stop else chunk_failure)  # past a terminal event: moot
         if failure or stop:
             break
     ts, ys = np.array(ts), np.array(ys)

@@ -10,6 +10,8 @@ repeats) and its number of right-hand-side evaluations.
 """
 from __future__ import annotations
 
+import math
+import re
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -38,7 +40,9 @@ class Run:
     failed: str | None = None
 
     def as_dict(self):
-        return {"integrator": self.integrator, "setting": self.setting, "error": self.error,
+        finite = lambda x: x if x is None or math.isfinite(x) else None  # JSON has no Infinity
+        return {"integrator": self.integrator, "setting": self.setting,
+                "error": finite(self.error),
                 "energy_drift": self.energy_drift, "wall_time_s": self.wall_time_s,
                 "rhs_evaluations": self.rhs_evaluations}
 
@@ -162,7 +166,7 @@ def _score(model, q0, u0, t_end, integ, setting, events, t_samples, ref, outputs
                 res = simulate(model, t_end, q0, u0, **kwargs)
         except SimulationError as exc:
             res = exc.result
-            failed = "failed: " + str(exc).split(".")[0]
+            failed = "failed: " + re.split(r"\.\s", str(exc))[0]
         walls.append(time.perf_counter() - start)
         if failed or walls[-1] > 1.0:     # slow runs are not repeated
             break

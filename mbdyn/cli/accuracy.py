@@ -83,7 +83,7 @@ def run(args):
         plot(study, args.plot, title=f"{scene.name}" + (f", case {scene.case}" if scene.case
                                                          else ""))
     if args.json:
-        sys.stdout.write(json.dumps(study.as_dict()) + "\n")
+        sys.stdout.write(json.dumps(study.as_dict(), allow_nan=False) + "\n")
     else:
         sys.stdout.write(study.table() + "\n")
         if args.plot:
