@@ -14,8 +14,10 @@ KanesMethod; CPU time of the process, which a busy machine disturbs less than wa
 both are in the JSON), the size of M and f (sympy.count_ops, before and after common subexpression
 elimination), and the cost of one call of mbdyn's generated, numba-compiled right-hand side
 (best of several repeats, which is what a quiet machine would show) next to the numeric
-engine's forward dynamics.  A second table gives the textbook's point: the double pendulum
-written with each body's own moving frame against one frame for all vectors.
+engine's forward dynamics.  A second table shows where the operations sit at the largest n:
+M, f and the last link's equation written nested (as the walk builds them), fully expanded,
+compact (mbdyn's default) and by KanesMethod.  A third gives the textbook's point: the double
+pendulum written with each body's own moving frame against one frame for all vectors.
 
     python benchmarks/symbolic.py                 # everything (Kane at n = 8 takes minutes)
     python benchmarks/symbolic.py --n 1 2 3 --no-kane
@@ -147,6 +149,8 @@ def run_chain(n, kane=True, check=True):
         row["kane_derive_s"] = time.process_time() - c0
         row["kane_derive_wall_s"] = time.perf_counter() - t0
         row["kane_ops"] = int(sp.count_ops(M) + sp.count_ops(f))
+        row["kane_ops_M"] = int(sp.count_ops(M))
+        row["kane_ops_f_last"] = int(sp.count_ops(f[n - 1]))
         t0 = time.perf_counter()
         row["kane_ops_cse"] = operations_after_cse([M, f])
         row["kane_cse_s"] = time.perf_counter() - t0
@@ -157,6 +161,33 @@ def run_chain(n, kane=True, check=True):
             row["kane_vs_mbdyn"] = float(max(np.abs(Mk - Mo).max() / np.abs(Mo).max(),
                                              np.abs(fk - fo).max() / np.abs(fo).max()))
     return row
+
+
+def representation_sizes(n, kane_row=None):
+    """Where the operations of the n-link chain sit, for three forms of the same equations:
+    the walk's nested expressions (``simplify="none"``), fully expanded, and mbdyn's default
+    (``compact``: the shorter of the two per expression) -- with KanesMethod's for scale.
+    ``f[n]`` is the last link's equation, which holds no other link's acceleration: its size
+    is what one link's bias acceleration costs in each form."""
+    model = mbdyn_chain(n).compile()
+    rows = []
+    for mode in ("none", "expand", "compact"):
+        d = derive(model, "jourdain", simplify=mode, measure=False)
+        rows.append({"form": mode, "M": int(sum(sp.count_ops(e) for e in d.mass_matrix)),
+                     "f": int(sum(sp.count_ops(e) for e in d.forcing)),
+                     "f_last": int(sp.count_ops(d.forcing[n - 1]))})
+    if kane_row is not None and "kane_ops_M" in kane_row:
+        rows.append({"form": "KanesMethod", "M": kane_row["kane_ops_M"],
+                     "f": kane_row["kane_ops"] - kane_row["kane_ops_M"],
+                     "f_last": kane_row["kane_ops_f_last"]})
+    return rows
+
+
+def print_representation_table(n, rows, out=sys.stdout):
+    head = f"form (n = {n})      ops M      ops f   ops f[{n}]"
+    out.write(head + "\n" + "-" * len(head) + "\n")
+    for r in rows:
+        out.write(f"{r['form']:<16}{r['M']:9d}{r['f']:11d}{r['f_last']:10d}\n")
 
 
 def double_pendulum_sizes():
@@ -231,7 +262,8 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--n", type=int, nargs="+", default=list(NS), help="chain lengths")
     ap.add_argument("--no-kane", action="store_true", help="skip sympy.physics.mechanics")
-    ap.add_argument("--no-sizes", action="store_true", help="skip the frames table")
+    ap.add_argument("--no-sizes", action="store_true",
+                    help="skip the frames and representation tables")
     ap.add_argument("--json", metavar="FILE", help="also write the results as JSON")
     args = ap.parse_args(argv)
     os.environ.setdefault("MBDYN_CACHE_DIR", os.path.join(tempfile.gettempdir(),
@@ -246,6 +278,11 @@ def main(argv=None):
     print_chain_table(rows)
     result = {"chain": rows}
     if not args.no_sizes:
+        n = max(args.n)
+        forms = representation_sizes(n, next(r for r in rows if r["n"] == n))
+        print(f"\nWhere the size sits: the {n}-link chain's M and f in three forms")
+        print_representation_table(n, forms)
+        result["forms"] = forms
         sizes = double_pendulum_sizes()
         print("\nOwn moving frames vs one frame (the textbook's point), three methods")
         print_size_table(sizes)
