@@ -198,3 +198,66 @@ def test_bad_tolerance_list_fails_with_one_line(capsys):
     code, out, err = cli(capsys, ROTATING, "--t-end", "0.1", "--tolerances", "1e-6,abc")
     assert code != 0 and out == "" and len(err.strip().splitlines()) == 1
     assert "--tolerances" in err
+
+
+# ----------------------------------------------------------------------------- honesty
+def test_steps_that_miss_the_error_samples_are_warned_about():
+    scene = mb.load_model(ROTATING)
+    kwargs = dict(integrators=("rk4",), steps=(0.2 / 200 * 0.7,), repeats=1)
+    with pytest.warns(UserWarning, match=r"do not divide.*0\.001/k"):
+        accuracy_study(scene.model, scene.q0, scene.u0, 0.2, **kwargs)
+
+
+def test_aligned_steps_raise_no_warning(recwarn):
+    scene = mb.load_model(ROTATING)
+    accuracy_study(scene.model, scene.q0, scene.u0, 0.2, integrators=("rk4",),
+                   steps=(0.2 / 200, 0.2 / 600), repeats=1)
+    assert not [w for w in recwarn if "divide" in str(w.message)]
+    assert not [w for w in recwarn if "cross-check" in str(w.message)]
+
+
+def test_a_poor_reference_is_warned_about(monkeypatch):
+    """A reference that its cross-check does not confirm (as on a chaotic run) is said so;
+    here the threshold is lowered below the rotating pendulum's genuine estimate."""
+    import mbdyn.analysis.accuracy as acc
+    monkeypatch.setattr(acc, "REFERENCE_WARNING", 0.0)
+    scene = mb.load_model(ROTATING)
+    with pytest.warns(UserWarning, match=r"cross-check differ by .*shorter --t-end"):
+        acc.accuracy_study(scene.model, scene.q0, scene.u0, 0.2, integrators=("rk4",),
+                           steps=(0.2 / 200,), repeats=1)
+
+
+def _trajectory(t, q):
+    from types import SimpleNamespace
+    return SimpleNamespace(t=np.asarray(t, float), q=np.asarray(q, float).reshape(len(t), -1))
+
+
+def test_error_compares_only_rows_at_the_same_time():
+    """A run stopped by a terminal event ends with a row at its own event time; it must not
+    be compared with the reference's row at a sample time."""
+    from mbdyn.analysis.accuracy import _max_error
+    ref = _trajectory([0.0, 0.1, 0.2, 0.3], [0.0, 1.0, 2.0, 3.0])
+    early = _trajectory([0.0, 0.1, 0.15], [0.0, 1.001, 9.0])      # event at 0.15
+    assert _max_error(early, ref) == pytest.approx(0.001)
+    late = _trajectory([0.0, 0.1, 0.2, 0.3], [0.0, 1.0, 2.002, 3.0])
+    ref_event = _trajectory([0.0, 0.1, 0.2, 0.25], [0.0, 1.0, 2.0, 7.0])
+    assert _max_error(late, ref_event) == pytest.approx(0.002)
+    assert _max_error(_trajectory([0.0, 0.05], [0.0, 0.0]),
+                      _trajectory([0.1, 0.2], [0.0, 0.0])) == math.inf
+
+
+def test_a_failed_run_has_a_null_error_in_json_and_is_named_on_stderr(capsys, monkeypatch):
+    from mbdyn.analysis.accuracy import Run
+    import mbdyn.cli.accuracy as cli_accuracy
+    ok = Run("rk4", 0.001, 1e-6, None, 0.01, 800)
+    bad = Run("euler", 0.01, 0.5, None, 0.01, 20, failed="failed: non-finite state at t=0.2")
+    assert ok.as_dict()["error"] == 1e-6 and bad.as_dict()["error"] is None
+    study = Study("stub", 0.2, [], 1e-12, 0.1, [ok, bad], False)
+    monkeypatch.setattr(cli_accuracy, "accuracy_study", lambda *a, **k: study)
+    code, out, err = cli(capsys, ROTATING, "--t-end", "0.2", "--json")
+    assert code == 0
+    d = strict_json(out)
+    assert [r["error"] for r in d["runs"]] == [1e-6, None]
+    assert "euler at 0.01 failed: non-finite state at t=0.2" in err
+    code, out, err = cli(capsys, ROTATING, "--t-end", "0.2")
+    assert "failed: non-finite state" in out.splitlines()[-1]    # the table says it too

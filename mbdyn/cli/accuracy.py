@@ -82,6 +82,11 @@ def run(args):
     if args.plot:
         plot(study, args.plot, title=f"{scene.name}" + (f", case {scene.case}" if scene.case
                                                          else ""))
+    failed = [r for r in study.runs if r.failed]
+    if failed and args.json:      # the schema has no field for it: say it on stderr
+        sys.stderr.write("mbdyn: warning: " + "; ".join(
+            f"{r.integrator} at {r.setting:g} {r.failed}" for r in failed)
+            + " (their error is null)\n")
     if args.json:
         sys.stdout.write(json.dumps(study.as_dict(), allow_nan=False) + "\n")
     else:
