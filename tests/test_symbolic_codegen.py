@@ -11,6 +11,8 @@ import mbdyn as mb
 from mbdyn.symbolic import compiled_rhs, random_states
 from mbdyn.symbolic.codegen import model_signature
 
+from textbook_systems import DOUBLE_PENDULUM_DATA, double_pendulum_system, with_symbols
+
 MODELS = Path(__file__).resolve().parent.parent / "models"
 
 
@@ -20,16 +22,7 @@ def cache(tmp_path_factory, monkeypatch):
 
 
 def double_pendulum(m2=0.0046):
-    g = sp.Symbol("g", real=True)
-    s = mb.System("double pendulum", gravity=(0, -g, 0),
-                  parameters={"m1": 0.00046, "m2": m2, "l1": 0.07, "l2": 0.07, "g": 9.81})
-    m1, m2, l1, l2 = s.symbols("m1 m2 l1 l2")
-    s.add_body("link1", mass=m1, com=(0, -l1, 0))
-    s.add_joint("theta1", "revolute", parent="ground", child="link1", axis="-z")
-    s.add_body("link2", mass=m2, com=(0, -l2, 0))
-    s.add_joint("theta2", "revolute", parent="link1", child="link2", axis="-z",
-                position=(0, -l1, 0))
-    return s
+    return with_symbols(double_pendulum_system, dict(DOUBLE_PENDULUM_DATA, m2=m2, g=9.81))
 
 
 def quaternion_model():

@@ -16,6 +16,9 @@ import sympy as sp
 import mbdyn as mb
 from mbdyn.symbolic import compare_methods, derive, same_expression
 
+from textbook_systems import (DOUBLE_PENDULUM_DATA, double_pendulum_system,
+                              rotating_pendulum_system, with_symbols)
+
 # ----------------------------------------------------------------------------- 1.4.2
 LISTING = {
     "ddt1": """(g*l2*m1*m2*Sin(t1) - Power(dt1,2)*Power(l2,2)*Power(m2,2)*Sin(t2) - 2*dt1*dt2*Power(l2,2)*Power(m2,2)*Sin(t2) -Power(dt2,2)*Power(l2,2)*Power(m2,2)*Sin(t2) -Power(dt1,2)*l1*l2*Power(m2,2)*Cos(t2)*Sin(t2) -g*l2*Power(m2,2)*Cos(t1 + t2)*Sin(t2))/(-(l1*l2*m1*m2) - l1*l2*Power(m2,2)*Power(Sin(t2),2))""",
@@ -35,16 +38,7 @@ def pascal(text, names):
 
 
 def double_pendulum():
-    g = sp.Symbol("g", real=True)
-    s = mb.System("double pendulum", gravity=(0, -g, 0),
-                  parameters={"m1": 0.00046, "m2": 0.0046, "l1": 0.07, "l2": 0.07, "g": 9.81})
-    m1, m2, l1, l2 = s.symbols("m1 m2 l1 l2")
-    s.add_body("link1", mass=m1, com=(0, -l1, 0))
-    s.add_joint("theta1", "revolute", parent="ground", child="link1", axis="-z")
-    s.add_body("link2", mass=m2, com=(0, -l2, 0))
-    s.add_joint("theta2", "revolute", parent="link1", child="link2", axis="-z",
-                position=(0, -l1, 0))
-    return s
+    return with_symbols(double_pendulum_system, dict(DOUBLE_PENDULUM_DATA, g=9.81))
 
 
 def test_double_pendulum_listing():
@@ -115,20 +109,8 @@ def test_top_three_equations_and_contact_force():
 
 # ----------------------------------------------------------------------------- 1.4.1
 def rotating_pendulum(Omega, omega):
-    s = mb.System("rotating pendulum", gravity=(0, 0, -sp.Symbol("g", real=True)),
-                  parameters={"a": 0.5, "b": 0.4, "c": 0.1, "r": 0.15, "h": 0.2, "l": 0.25,
-                              "m": 0.1, "g": 9.81})
-    a, b, c, r, h, l, m = s.symbols("a b c r h l m")
-    s.add_frame("arm")
-    s.add_joint("Omega", "revolute", parent="ground", child="arm", axis="z",
-                position=(0, 0, a), drive=Omega * mb.t)
-    s.add_frame("disk")
-    s.add_joint("omega", "revolute", parent="arm", child="disk", axis="z",
-                position=(0, b, c), drive=omega * mb.t)
-    s.add_body("pendulum", mass=m, com=(0, 0, -l))
-    s.add_joint("beta", "revolute", parent="disk", child="pendulum", axis="x",
-                position=(0, r, h))
-    return s
+    values = {"a": 0.5, "b": 0.4, "c": 0.1, "r": 0.15, "h": 0.2, "l": 0.25, "m": 0.1, "g": 9.81}
+    return with_symbols(rotating_pendulum_system, values, Omega=Omega, omega=omega)
 
 
 def test_rotating_pendulum_equation_and_reactions():

@@ -4,13 +4,14 @@ Each builder returns an uncompiled ``mb.System``; the tests compile it.  The cho
 text leaves open are documented where they are made.
 """
 import numpy as np
+import sympy as sp
 
 import mbdyn as mb
 
 G = 9.81
 
 
-def rotating_pendulum_system(Omega, omega, a, b, c, r, h, l, m, g=G):
+def rotating_pendulum_system(Omega, omega, a, b, c, r, h, l, m, g=G, parameters=None):
     """Example 1 (1.4.1): a particle pendulum on a disk turning on a turning arm.
 
     Frames as in the text: the arm B1 turns about Z at ``Omega`` (joint ``"Omega"``, at the
@@ -25,7 +26,7 @@ def rotating_pendulum_system(Omega, omega, a, b, c, r, h, l, m, g=G):
     particle (mass ``m``, frame ``"pendulum"``).  The reaction of joint ``"beta"`` is then
     the rod/hinge force on E: in B3 components it is the text's ``[R, 0, T]``.
     """
-    s = mb.System("rotating pendulum", gravity=(0.0, 0.0, -g))
+    s = mb.System("rotating pendulum", gravity=(0.0, 0.0, -g), parameters=parameters)
     s.add_frame("arm")
     s.add_joint("Omega", "revolute", parent="ground", child="arm", axis="z",
                 position=(0.0, 0.0, a), drive=Omega * mb.t)
@@ -38,7 +39,7 @@ def rotating_pendulum_system(Omega, omega, a, b, c, r, h, l, m, g=G):
     return s
 
 
-def double_pendulum_system(m1, m2, l1, l2, g=G):
+def double_pendulum_system(m1, m2, l1, l2, g=G, parameters=None):
     """Example 2 (1.4.2): two particles on massless rods, gravity along -y.
 
     ``theta1`` is rod 1's angle from the downward vertical, ``theta2`` rod 2's angle
@@ -52,13 +53,21 @@ def double_pendulum_system(m1, m2, l1, l2, g=G):
     positive, the listing's ``Tr1``, ``Tr2``) is the +y component, in the child frame, of
     the reaction of joint ``theta1`` resp. ``theta2``.
     """
-    s = mb.System("double pendulum", gravity=(0.0, -g, 0.0))
+    s = mb.System("double pendulum", gravity=(0.0, -g, 0.0), parameters=parameters)
     s.add_body("link1", mass=m1, com=(0.0, -l1, 0.0))
     s.add_joint("theta1", "revolute", parent="ground", child="link1", axis="-z")
     s.add_body("link2", mass=m2, com=(0.0, -l2, 0.0))
     s.add_joint("theta2", "revolute", parent="link1", child="link2", axis="-z",
                 position=(0.0, -l1, 0.0))
     return s
+
+
+def with_symbols(builder, values, **fixed):
+    """An example with the parameters named in ``values`` as sympy symbols, declared with
+    those values as the System's parameters (for the symbolic derivation); ``fixed`` are
+    passed to ``builder`` as they are (e.g. the rotating pendulum's drive rates)."""
+    symbols = {name: sp.Symbol(name, real=True) for name in values}
+    return builder(**symbols, **fixed, parameters=dict(values))
 
 
 def top_inertia_about_com(m, h, A, C):
