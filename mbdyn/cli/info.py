@@ -8,6 +8,7 @@ import warnings
 
 import numpy as np
 
+from ..io.results import outputs_spec
 from .common import add_model_arguments, fmt, load
 
 
@@ -68,11 +69,7 @@ def describe(scene):
         "dof": model.nu, "drives": drives, "loads": loads,
         "events": list(scene.event_specs), "initial": scene.initial_state,
         "simulation": dict(scene.settings),
-        "outputs": {"reactions": list(scene.outputs["reactions"]),
-                    "reactions_frame": scene.outputs["reactions_frame"],
-                    "energy": scene.outputs["energy"],
-                    "points": {k: {"frame": f, "offset": list(o)}
-                               for k, (f, o) in scene.outputs["points"].items()}},
+        "outputs": outputs_spec(scene),
         "warnings": list(scene.warnings),
     }
 

@@ -24,6 +24,14 @@ def _float(x):
     return x if math.isfinite(x) else None
 
 
+def outputs_spec(scene):
+    """The ``[outputs]`` a scene asked for, as plain JSON data."""
+    out = scene.outputs
+    return {"reactions": list(out["reactions"]), "reactions_frame": out["reactions_frame"],
+            "energy": out["energy"],
+            "points": {k: {"frame": f, "offset": list(o)} for k, (f, o) in out["points"].items()}}
+
+
 def summary(scene, result):
     """The ``mbdyn run --json`` object::
 
@@ -146,11 +154,7 @@ def write_results(directory, scene, result, status="ok", error=None, extra=None)
         "parameters": scene.parameters,
         "initial": scene.initial_state,
         "simulation": {k: v for k, v in scene.settings.items()},
-        "outputs": {"reactions": list(scene.outputs["reactions"]),
-                    "reactions_frame": scene.outputs["reactions_frame"],
-                    "energy": scene.outputs["energy"],
-                    "points": {k: {"frame": f, "offset": list(o)}
-                               for k, (f, o) in scene.outputs["points"].items()}},
+        "outputs": outputs_spec(scene),
         "warnings": list(scene.warnings),
         "csv": os.path.basename(csv_path),
         "columns": names,
