@@ -275,6 +275,45 @@ def test_singular_mass_matrix_names_the_coordinates_at_evaluation():
     assert e.value.coordinates == ("spin_dot",)
 
 
+def _long_chain_with_bead(bead_inertia):
+    """A 45-link chain (past the size where LAPACK factorizes M) ending in a bead on a
+    spin joint about its own axis: with no inertia about that axis M is singular."""
+    from mbdyn.kernels.dynamics import LAPACK_CHOLESKY_FROM
+    s = mb.System("long chain")
+    parent = "ground"
+    for i in range(45):
+        s.add_body(f"link{i}", mass=1.0, com=(0.0, 0.0, -0.5), inertia=(0.1, 0.1, 0.02))
+        s.add_joint(f"q{i}", "revolute", parent=parent, child=f"link{i}",
+                    axis="x" if i % 2 else "y", position=(0.0, 0.0, -1.0 if i else 0.0))
+        parent = f"link{i}"
+    s.add_body("bead", mass=1.0, inertia=(1.0, 1.0, bead_inertia))
+    s.add_joint("spin", "revolute", parent=parent, child="bead", axis="z",
+                position=(0.0, 0.0, -1.0))
+    model = s.compile(check_inertia=False)
+    assert model.nu >= LAPACK_CHOLESKY_FROM
+    return model
+
+
+@pytest.mark.parametrize("bead_inertia", [0.0, 1e-30])
+def test_singular_mass_matrix_of_a_large_model_names_the_coordinate(bead_inertia):
+    """Zero inertia makes LAPACK's factorization fail; 1e-30 passes it with a pivot far
+    below the matrix's scale -- both are reported, naming the speed."""
+    model = _long_chain_with_bead(bead_inertia)
+    rng = np.random.default_rng(0)
+    q = rng.uniform(-1, 1, model.nq)
+    with pytest.raises(mb.SingularMassMatrixError, match=r"degrees of freedom spin \(joint 'spin'\)"):
+        model.forward_dynamics(q, np.zeros(model.nu))
+
+
+def test_large_model_accelerations_solve_m_and_f():
+    model = _long_chain_with_bead(0.01)
+    rng = np.random.default_rng(1)
+    q, u = rng.uniform(-1, 1, model.nq), rng.uniform(-1, 1, model.nu)
+    ud = model.forward_dynamics(q, u)
+    expected = np.linalg.solve(model.mass_matrix(q), model.forcing(q, u))
+    assert np.allclose(ud, expected, rtol=1e-9, atol=1e-9 * np.abs(expected).max())
+
+
 # ---------------------------------------------------------------------------- euler / drives
 @pytest.mark.parametrize("sequence", ["ZZX", "XYY", "ZX", "ABC", "ZXZY"])
 def test_bad_euler_sequence_is_refused(sequence):

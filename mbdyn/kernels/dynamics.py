@@ -199,6 +199,25 @@ def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc
                 M[b_, a_] = val
 
 
+#: from this size on the factorization is LAPACK's (faster for large matrices, measured
+#: crossover about 30); a failure is then located by the written-out loop below
+LAPACK_CHOLESKY_FROM = 40
+
+
+@njit(cache=True)
+def _lapack_cholesky(M, L, tiny):
+    """``L`` from LAPACK's Cholesky; False if it fails or a pivot is below ``tiny``."""
+    try:
+        Lf = np.linalg.cholesky(M)
+    except Exception:
+        return False
+    for j in range(M.shape[0]):
+        if not (Lf[j, j] * Lf[j, j] > tiny):
+            return False
+    L[:, :] = Lf
+    return True
+
+
 @njit(cache=True)
 def cholesky_solve(M, f, L, x):
     """Solve ``M x = f`` by Cholesky.  Returns -1, or the index of the first pivot that is
@@ -208,6 +227,8 @@ def cholesky_solve(M, f, L, x):
     for j in range(n):
         scale = max(scale, abs(M[j, j]))
     tiny = 1e-14 * scale if scale > 0.0 else 1e-300
+    if n >= LAPACK_CHOLESKY_FROM and _lapack_cholesky(M, L, tiny):
+        return _triangular_solves(L, f, x)
     for j in range(n):
         s = M[j, j]
         for k in range(j):
@@ -220,6 +241,13 @@ def cholesky_solve(M, f, L, x):
             for k in range(j):
                 s -= L[i, k] * L[j, k]
             L[i, j] = s / L[j, j]
+    return _triangular_solves(L, f, x)
+
+
+@njit(cache=True)
+def _triangular_solves(L, f, x):
+    """``x`` from ``L L^T x = f`` (``L`` lower triangular); returns -1."""
+    n = L.shape[0]
     for i in range(n):                  # forward: L y = f
         s = f[i]
         for k in range(i):
