@@ -16,8 +16,8 @@ What it measures
   on chains of n = 2, 5, 10, 20, 50 bodies joined by (a) revolute joints with alternating
   x / y axes (a 3D chain) and (b) spherical joints; the ratio newton-euler / jourdain taken
   round by round in the same run; ``Model.mass_matrix(q)``.
-* The raw compiled kernels (``mbdyn.kernels.evaluate.jourdain_accelerations`` and
-  ``newton_euler_solution``) called with the model's own arrays, so that
+* The raw compiled kernels (``mbdyn.kernels.packed.jourdain_accelerations_packed`` and
+  ``newton_euler_solution_packed``) called with the model's own packed arrays, so that
   ``method - raw`` is the Python overhead of the ``Model`` layer; and a do-nothing numba
   function taking the same arguments, which is the cost of numba's dispatch (type matching
   and unboxing of every argument) inside the raw call.
@@ -25,8 +25,8 @@ What it measures
   kernel called in a loop from inside compiled code, no dispatch), numba's dispatch, and
   the Python layer -- ``Model.forward_dynamics`` timed with the kernel swapped (during
   those blocks only) for the do-nothing function -- split into the ``Model`` helpers one
-  call actually runs (``_fill``, ``_check_finite``: found by wrapping them for one call),
-  building the argument tuple (if the model has no prebuilt one) and the rest.
+  call actually runs (``HELPERS``: found by wrapping them for one call)
+  and the rest.
 * With ``--steps``: the compute time of each compiled step (kinematics and loads; ``M``
   and ``f``; Cholesky; the Newton-Euler assembly; its LU solve) for every size.
 * The kernels' numba compile time, "cold" (a subprocess with ``NUMBA_CACHE_DIR`` set to a
@@ -200,25 +200,39 @@ def measure(cases, budget, repeats, ratios=()):
 
 
 # ----------------------------------------------------------------------------- raw kernels
-def jourdain_kernel_args(model, ud=None):
-    """The argument tuple ``Model.forward_dynamics(method="jourdain")`` passes to
-    ``jourdain_accelerations``: the model's prebuilt tuple if it has one, otherwise built
-    as mbdyn/compile.py used to (with ``ud`` as the output)."""
-    m = model
-    prebuilt = getattr(m, "_jourdain_args", None)
-    if prebuilt is not None:
-        return prebuilt
-    if ud is None:
-        ud = np.empty(m.nu)
-    return (*m._tree, m._mass, m._com, m._inertia, m._has_inertia, m.gravity, m._qfull,
-            m._ufull, m._udfull, *m._loads_arrays, *m._kin_out, m._M, m._f, m._L, ud)
+def packed_args(model, q, u):
+    """The arguments ``Model.forward_dynamics`` passes to the packed Jourdain kernel: the
+    float buffer, the integer buffer, the offset table (``mbdyn.kernels.packed``), q, u."""
+    return (*model._packed, np.asarray(q, float), np.asarray(u, float))
 
 
-def newton_euler_kernel_args(model):
-    m = model
-    return (*m._tree, m._mass, m._com, m._inertia, m.gravity, m._qfull, m._ufull, m._udfull,
-            *m._loads_arrays, m._react_joint, m._react_force, m._react_moment, *m._kin_out,
-            m._A, m._b)
+_PACKED = {}
+
+
+def packed_helpers(kernel):
+    """``nop(fb, ib, t, q, u)``: zeroes the packed ``ud`` and returns -1 at once (its call
+    cost is numba's dispatch for the five arguments); ``loop(count, fb, ib, t, q, u)``:
+    calls ``kernel`` ``count`` times from compiled code (its compute time without
+    dispatch)."""
+    if kernel not in _PACKED:
+        from numba import njit
+        from mbdyn.kernels import packed as kp
+        UD = kp.UD
+
+        @njit
+        def nop(fb, ib, t, q, u):
+            fb[t[UD]:t[UD] + t[1]] = 0.0
+            return -1
+
+        loop = None
+        if kernel is not None:
+            @njit
+            def loop(count, fb, ib, t, q, u):
+                for _ in range(count):
+                    kernel(fb, ib, t, q, u)   # writes its outputs: cannot be elided
+                return count
+        _PACKED[kernel] = (nop, loop)
+    return _PACKED[kernel]
 
 
 _GENERATED = {}
@@ -265,8 +279,8 @@ def subkernel_cases(model, q, u, ke):
     ud = np.empty(m.nu)
     kin = (*m._tree, m._mass, m._com, m.gravity, m._qfull, m._ufull, m._udfull,
            *m._loads_arrays, *m._kin_out)
-    jd = (m._mass, m._com, m._inertia, m._has_inertia, m._R, m._w, m._alpha, m._a, m._JR,
-          m._JT, m._anc_ptr, m._anc_idx, m._F, m._N, m._M, m._f)
+    jd = (m._mass, m._com, m._inertia, m._has_inertia, m._R, m._r, m._w, m._alpha, m._a,
+          m._JR, m._JT, m._anc_ptr, m._anc_idx, m._parent, m._F, m._N, m._M, m._f)
     ch = (m._M, m._f, m._L, ud)
     nes = (m._mass, m._com, m._inertia, m._parent, m._R, m._r, m._w, m._alpha, m._a, m._JR,
            m._JT, m._anc_ptr, m._anc_idx, m._F, m._N, m._react_joint, m._react_force,
@@ -288,16 +302,16 @@ _SOLVE = None
 class Raw:
     """Raw-kernel access to a model; ``ok`` False (with ``why``) if the internals moved."""
 
-    def __init__(self, model, q, u, ke):
+    def __init__(self, model, q, u, kp):
         self.ok, self.why = False, ""
         try:
             model._fill(q, u, 0.0)
-            self.jargs = jourdain_kernel_args(model)
-            self.ud = self.jargs[-1]
-            self.prebuilt = getattr(model, "_jourdain_args", None) is not None
-            self.neargs = newton_euler_kernel_args(model)
-            self.jk = ke.jourdain_accelerations
-            self.nek = ke.newton_euler_solution
+            self.jargs = packed_args(model, q, u)
+            self.ud = model._ud
+            self.prebuilt = True
+            self.neargs = model._packed
+            self.jk = kp.jourdain_accelerations_packed
+            self.nek = kp.newton_euler_solution_packed
             ref = model.forward_dynamics(q, u, 0.0, method="jourdain")
             model._fill(q, u, 0.0)
             pivot = self.jk(*self.jargs)
@@ -438,19 +452,19 @@ def machine_info():
 
 
 # ----------------------------------------------------------------------------- main runs
-def run_table(mb, ke, sizes, budget, repeats):
+def run_table(mb, kp, sizes, budget, repeats):
     rows = []
     for joint in JOINTS:
         for n in sizes:
             log(f"  {joint} chain, n={n} ...")
             model, q, u = build_chain(mb, n, joint)
-            raw = Raw(model, q, u, ke)
+            raw = Raw(model, q, u, kp)
             fd = model.forward_dynamics
             cases = {"jourdain": (fd, (q, u, 0.0), {"method": "jourdain"}, 1),
                      "newton-euler": (fd, (q, u, 0.0), {"method": "newton-euler"}, 1),
                      "mass_matrix": (model.mass_matrix, (q,), {}, 1)}
             if raw.ok:
-                nop, _ = generated_kernels(len(raw.jargs), None)
+                nop, _ = packed_helpers(None)
                 cases["jourdain_raw"] = (raw.jk, raw.jargs, {}, 1)
                 cases["newton-euler_raw"] = (raw.nek, raw.neargs, {}, 1)
                 cases["dispatch"] = (nop, raw.jargs, {}, 1)
@@ -493,7 +507,7 @@ def run_subkernels(mb, ke, sizes, budget, repeats):
     return rows
 
 
-HELPERS = ("_fill", "_check_finite")
+HELPERS = ("_fill", "_state", "_fill_inputs", "_check_finite")
 
 
 def helpers_called(model, q, u):
@@ -519,12 +533,12 @@ def helpers_called(model, q, u):
     return called
 
 
-def run_breakdown(mb, ke, budget, repeats, with_compute, specs=(("revolute", 2),
+def run_breakdown(mb, kp, budget, repeats, with_compute, specs=(("revolute", 2),
                                                                   ("revolute", 5),
                                                                   ("spherical", 2))):
     """Where the time of one small Jourdain call goes.
 
-    ``Model.forward_dynamics`` is also timed with ``ke.jourdain_accelerations`` swapped
+    ``Model.forward_dynamics`` is also timed with ``kp.jourdain_accelerations_packed`` swapped
     (for the duration of those blocks only) for the do-nothing numba function taking the
     same arguments: that is the engine's Python layer plus numba's dispatch, with no
     compute.  The helpers of ``HELPERS`` that one call runs are timed on their own.
@@ -533,43 +547,41 @@ def run_breakdown(mb, ke, budget, repeats, with_compute, specs=(("revolute", 2),
     for joint, n in specs:
         log(f"  breakdown: {joint} chain, n={n} ...")
         model, q, u = build_chain(mb, n, joint)
-        raw = Raw(model, q, u, ke)
+        raw = Raw(model, q, u, kp)
         if not raw.ok:
             return {"unavailable": raw.why}
-        nop, loop = generated_kernels(len(raw.jargs), raw.jk if with_compute else None)
+        nop, loop = packed_helpers(raw.jk if with_compute else None)
         inner = 200
         ud = model.forward_dynamics(q, u, 0.0)
         m = model
-        real = ke.jourdain_accelerations
+        real = kp.jourdain_accelerations_packed
 
         @contextlib.contextmanager
         def no_kernel():
-            ke.jourdain_accelerations = nop
+            kp.jourdain_accelerations_packed = nop
             try:
                 yield
             finally:
-                ke.jourdain_accelerations = real
+                kp.jourdain_accelerations_packed = real
 
         with no_kernel():
             swapped = m.forward_dynamics(q, u, 0.0)
         if np.any(swapped != 0.0) or np.any(m.forward_dynamics(q, u, 0.0) != ud):
             return {"unavailable": "Model.forward_dynamics no longer calls "
-                                   "mbdyn.kernels.evaluate.jourdain_accelerations by its "
-                                   "module attribute"}
+                                   "mbdyn.kernels.packed.jourdain_accelerations_packed by "
+                                   "its module attribute"}
         called = helpers_called(m, q, u)
 
         cases = {"method": (m.forward_dynamics, (q, u, 0.0), {}, 1),
                  "method_no_kernel": (m.forward_dynamics, (q, u, 0.0), {}, 1, no_kernel),
                  "raw": (raw.jk, raw.jargs, {}, 1),
                  "dispatch": (nop, raw.jargs, {}, 1)}
-        if "_fill" in called:
-            cases["_fill"] = (m._fill, (q, u, 0.0), {}, 1)
+        for name, args in (("_fill", (q, u, 0.0)), ("_state", (q, u)),
+                           ("_fill_inputs", (q, u, 0.0))):
+            if name in called:
+                cases[name] = (getattr(m, name), args, {}, 1)
         if "_check_finite" in called:
             cases["_check_finite"] = (m._check_finite, (q, u, 0.0, ud, "x"), {}, 1)
-        if not raw.prebuilt:
-            def build_args():
-                return jourdain_kernel_args(m, np.empty(m.nu))
-            cases["build_args"] = (build_args, (), {}, 1)
         if with_compute:
             if not out:
                 log("    (compiling an in-loop wrapper of the kernel; takes a few seconds)")
@@ -683,12 +695,10 @@ def print_report(report):
                 python = t["method_no_kernel"] - t["dispatch"]
                 parts = [(f"Model.{h}" + (f" (x{k})" if k > 1 else ""), k * t[h])
                          for h, k in b["helpers_called"].items() if h in t]
-                if "build_args" in t:
-                    parts.append(("38-argument tuple + np.empty", t["build_args"]))
                 rest = python - sum(v for _, v in parts)
                 lines = [("Model.forward_dynamics(q, u, t)", total),
                          ("  " + clabel, compute),
-                         (f"  numba dispatch: do-nothing call, same {b.get('nargs', 38)} "
+                         (f"  numba dispatch: do-nothing call, same {b.get('nargs', 3)} "
                           "args", t["dispatch"]),
                          ("  Python layer (method with do-nothing kernel", None),
                          ("                - do-nothing call)", python)]
@@ -697,7 +707,7 @@ def print_report(report):
                           ("  interplay (total - compute - method with do-nothing", None),
                           ("     kernel): caches, predictors, noise",
                            total - compute - t["method_no_kernel"]),
-                          ("for reference: raw kernel call, prebuilt args", t["raw"])]
+                          ("for reference: raw kernel call, packed args", t["raw"])]
                 cols.append([(label, val, None if val is None else 100 * val / total)
                              for label, val in lines])
             for (label, med, pm), (_, mn, pn) in zip(*cols):
@@ -793,6 +803,7 @@ def main(argv=None):
     log("importing mbdyn ...")
     import mbdyn as mb
     from mbdyn.kernels import evaluate as ke
+    from mbdyn.kernels import packed as kp
     report = {"machine": machine_info(),
               "settings": {"sizes": list(sizes), "budget_s": budget, "repeats": repeats,
                            "quick": args.quick, "steps": args.steps},
@@ -804,9 +815,9 @@ def main(argv=None):
     report["first_use_in_this_process_s"] = perf_counter() - t0
 
     log("timing the forward dynamics ...")
-    report["table"] = run_table(mb, ke, sizes, budget, repeats)
+    report["table"] = run_table(mb, kp, sizes, budget, repeats)
     if not args.no_breakdown:
-        report["breakdown"] = run_breakdown(mb, ke, budget, repeats, with_compute=not args.quick)
+        report["breakdown"] = run_breakdown(mb, kp, budget, repeats, with_compute=not args.quick)
     if args.steps:
         report["steps"] = run_subkernels(mb, ke, sizes, budget, repeats)
     if not args.no_compile:

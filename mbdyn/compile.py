@@ -19,6 +19,7 @@ from .errors import ModelError, NonFiniteError, SingularMassMatrixError
 from .kernels import dynamics as kd
 from .kernels import evaluate as ke
 from .kernels import joints as kj
+from .kernels import packed as kp
 from .kernels.kinematics import point_jacobian
 
 METHODS = ("jourdain", "newton-euler")
@@ -204,15 +205,15 @@ class Model:
         self._load_in_body = np.array([ld.in_body for ld in loads], np.bool_)
         self._load_force = np.zeros((nl, 3))
         self._load_moment = np.zeros((nl, 3))
-        self._load_functions = []         # (load name, target array row, callable)
+        load_functions = []               # (load name, array, row, callable)
         for k, ld in enumerate(loads):
-            for target, val in ((self._load_force, ld.force), (self._load_moment, ld.moment)):
+            for target, val in (("_load_force", ld.force), ("_load_moment", ld.moment)):
                 if isinstance(val, tuple):
                     val = self._lambdify_load(ld.name, val)
                 if callable(val):
-                    self._load_functions.append((ld.name, target[k], val))
+                    load_functions.append((ld.name, target, k, val))
                 else:
-                    target[k] = val
+                    getattr(self, target)[k] = val
         # -- workspace
         self._qfull = np.zeros(nqf)
         self._ufull = np.zeros(nuf)
@@ -233,22 +234,33 @@ class Model:
         self._L = np.zeros((self.nu, self.nu))
         self._A = np.zeros((6 * n, 6 * n))
         self._b = np.zeros(6 * n)
+        self._ud = np.zeros(self.nu)
+        self._slots = np.array(self._free_joint_slots, np.int64).reshape(-1, 5)
+        self._pack()
+        #: (load name, the row of the load array its function fills, the function)
+        self._load_functions = [(name, getattr(self, target)[k], fn)
+                                for name, target, k, fn in load_functions]
+        #: drives or function loads: values Python writes before each compiled evaluation
+        self._python_inputs = bool(self._driven or self._load_functions)
         self._tree = (self._parent, self._kind, self._axis, self._seq, self._pos, self._C,
                       self._qoff, self._uoff, self._ucol, self._anc_ptr, self._anc_idx)
         self._loads_arrays = (self._load_body, self._load_point, self._load_force,
                               self._load_moment, self._load_in_body)
         self._kin_out = (self._R, self._r, self._w, self._v, self._alpha, self._a,
                          self._JR, self._JT, self._F, self._N)
-        self._ud = np.zeros(self.nu)
-        self._slots = np.array(self._free_joint_slots, np.int64).reshape(-1, 5)
-        self._jourdain_args = (*self._tree, self._mass, self._com, self._inertia,
-                               self._has_inertia, self.gravity, self._qfull, self._ufull,
-                               self._udfull, *self._loads_arrays, *self._kin_out, self._M,
-                               self._f, self._L, self._ud)
-        self._newton_euler_args = (*self._tree, self._mass, self._com, self._inertia,
-                                   self.gravity, self._qfull, self._ufull, self._udfull,
-                                   *self._loads_arrays, self._react_joint, self._react_force,
-                                   self._react_moment, *self._kin_out, self._A, self._b)
+
+    def _pack(self):
+        """Move every array the fused kernels use into two flat buffers
+        (``kernels.packed``): the attributes become views of them, and a kernel call
+        passes three arrays instead of 38."""
+        attr = {name: "gravity" if name == "gravity" else "_" + name
+                for name in kp.FLOATS + kp.INTS}
+        fbuf, ibuf, table, views = kp.pack(
+            {k: getattr(self, attr[k]) for k in kp.FLOATS},
+            {k: getattr(self, attr[k]) for k in kp.INTS})
+        for name, view in views.items():
+            setattr(self, attr[name], view)
+        self._packed = (fbuf, ibuf, table)
 
     def _lambdify_load(self, name, exprs):
         """A callable ``(t, q, u) -> 3 values`` from sympy expressions of ``t`` and the
@@ -362,6 +374,19 @@ class Model:
             self._qfull[:] = q
             self._ufull[:] = u
         self._udfull[:] = 0.0
+        self._fill_inputs(q, u, t)
+        return q, u
+
+    def _state(self, q, u):
+        q = np.asarray(q, dtype=float)
+        u = np.asarray(u, dtype=float)
+        if q.shape != (self.nq,) or u.shape != (self.nu,):
+            raise ModelError(f"model {self.name!r} expects q of length {self.nq} and u of "
+                             f"length {self.nu}, got {q.shape} and {u.shape}")
+        return q, u
+
+    def _fill_inputs(self, q, u, t):
+        """The drives' values and the loads given as Python functions, at ``t``."""
         for name, kq, ku, drive in self._driven:
             self._qfull[kq] = drive.position(t)
             self._ufull[ku] = drive.velocity(t)
@@ -372,9 +397,8 @@ class Model:
                 raise ModelError(f"load {name!r}: its function returned {val.size} values at "
                                  f"t={t}; it must return three")
             row[:] = val
-        return q, u
 
-    def _check_finite(self, q, u, t, out, what):
+    def _check_finite(self, q, u, t, out, what, names=None):
         if np.all(np.isfinite(out)):
             return
         if not np.all(np.isfinite(q)) or not np.all(np.isfinite(u)):
@@ -391,7 +415,7 @@ class Model:
                     and np.isfinite(self._udfull[ku])):
                 raise NonFiniteError(f"model {self.name!r}, t={t:.6g}: the drive of joint "
                                      f"{name!r} gave a non-finite value")
-        bad = [n for n, x in zip(self.speeds, out) if not np.isfinite(x)]
+        bad = [n for n, x in zip(names or self.speeds, out) if not np.isfinite(x)]
         raise NonFiniteError(f"model {self.name!r}, t={t:.6g}: {what} came out non-finite "
                              f"for {', '.join(bad) or 'some entries'}")
 
@@ -461,8 +485,10 @@ class Model:
         """Speed rates ``u'`` from ``M(q) u' = f(q, u, t)`` (``method="jourdain"``) or from
         the Newton-Euler system with reactions (``method="newton-euler"``)."""
         if method == "jourdain":
-            q, u = self._fill(q, u, t)
-            pivot = ke.jourdain_accelerations(*self._jourdain_args)
+            q, u = self._state(q, u)
+            if self._python_inputs:
+                self._fill_inputs(q, u, t)
+            pivot = kp.jourdain_accelerations_packed(*self._packed, q, u)
             if pivot >= 0:
                 self._raise_singular(q, t, pivot)
             if pivot == -2:
@@ -472,10 +498,30 @@ class Model:
             return self._newton_euler(q, u, t)[:self.nu].copy()
         raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")
 
+    def state_derivative(self, t, y):
+        """``[q', u']`` for the state ``y = [q, u]`` by the Jourdain formulation, in one
+        compiled call: ``q' = N(q) u`` (``coordinate_rates``) and ``u'`` from
+        ``forward_dynamics``.  Returns a new array."""
+        y = np.asarray(y, dtype=float)
+        if y.shape != (self.nq + self.nu,):
+            raise ModelError(f"model {self.name!r} expects a state of length "
+                             f"{self.nq + self.nu} (q then u), got shape {y.shape}")
+        if self._python_inputs:
+            self._fill_inputs(y[:self.nq], y[self.nq:], t)
+        ydot = np.empty(self.nq + self.nu)
+        status = kp.state_derivative_packed(*self._packed, y, ydot)
+        if status >= 0:
+            self._raise_singular(y[:self.nq], t, status)
+        if status == -2:
+            rates = [c + "'" for c in self.coordinates] + [s + "'" for s in self.speeds]
+            self._check_finite(y[:self.nq], y[self.nq:], t, ydot, "the state derivative",
+                               rates)
+        return ydot
+
     def _newton_euler(self, q, u, t):
         q, u = self._fill(q, u, t)
         try:
-            x = ke.newton_euler_solution(*self._newton_euler_args)
+            x = kp.newton_euler_solution_packed(*self._packed)
         except np.linalg.LinAlgError:
             self._jourdain_terms(q, u, t)
             self._raise_singular(q, t, None)

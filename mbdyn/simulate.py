@@ -208,6 +208,8 @@ class _RightHandSide:
         self.evaluations += 1
         if self.symbolic is not None:
             return self.symbolic(t, y)  # a new array every call
+        if self.method == "jourdain":
+            return self.model.state_derivative(t, y)   # a new array every call
         q = y[:self.nq]
         u = y[self.nq:]
         out = np.empty_like(y)      # a fresh array: scipy's solvers keep what they are given

@@ -86,6 +86,38 @@ def test_jourdain_and_newton_euler_agree(seed):
         assert np.linalg.eigvalsh(M)[0] > 0
 
 
+@pytest.mark.parametrize("seed", SEEDS)
+def test_state_derivative_is_coordinate_rates_and_accelerations(seed):
+    """The fused compiled call against its two parts -- after another evaluation has left
+    different values in the shared workspace (the kinematics with nonzero speed rates)."""
+    t = tree(seed)
+    m = t.model
+    y = np.concatenate([t.q, t.u])
+    rng = np.random.default_rng(seed)
+    m.kinematics(t.q, -t.u, rng.uniform(-5, 5, m.nu), t.t + 0.3)
+    ydot = m.state_derivative(t.t, y)
+    rates = m.coordinate_rates(t.q, t.u)
+    m.kinematics(t.q, -t.u, rng.uniform(-5, 5, m.nu), t.t + 0.3)
+    ud = m.forward_dynamics(t.q, t.u, t.t)
+    b = m.forward_dynamics(t.q, t.u, t.t, method="newton-euler")
+    assert ydot.shape == (m.nq + m.nu,)
+    assert np.array_equal(ydot[:m.nq], rates)
+    assert np.array_equal(ydot[m.nq:], ud)
+    assert m.nu == 0 or rel(ud, b) < 1e-10
+    assert m.state_derivative(t.t, y) is not ydot             # a new array every call
+
+
+def test_state_derivative_refuses_a_wrong_state_and_names_a_non_finite_one():
+    t = tree(SEEDS[0])
+    m = t.model
+    with pytest.raises(mb.ModelError, match=r"state of length \d+ \(q then u\)"):
+        m.state_derivative(0.0, np.zeros(m.nq + m.nu + 1))
+    y = np.concatenate([t.q, t.u])
+    y[m.nq] = np.nan
+    with pytest.raises(mb.NonFiniteError, match=m.speeds[0]):
+        m.state_derivative(t.t, y)
+
+
 @settings(max_examples=12, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow])
 @given(seed=st.integers(1000, 10**6))

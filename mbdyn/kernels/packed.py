@@ -1,0 +1,167 @@
+"""The compiled model's arrays packed into two flat buffers, for cheap calls.
+
+numba checks the type of every argument of a compiled function at each call from Python
+(about 0.1 us per array), so a kernel with 38 array arguments spends more time there than
+computing a small model.  ``pack`` lays all the model's float arrays (data, state and
+workspace) in one buffer and its integer arrays in another and returns a view of each; the
+``*_packed`` kernels take the two buffers and an offset table and cut the same views
+inside compiled code.  Writing into a view (the state, the loads) is writing into the
+buffer, so the Python side keeps using its arrays as before.
+
+The Jourdain entry points also scatter the free coordinates and speeds into the joint-space
+state (what ``Model._fill`` does in Python for the other evaluations); drives and loads
+given as Python functions are still written by the caller first.
+"""
+import numpy as np
+from numba import njit
+
+from .evaluate import jourdain_accelerations, newton_euler_solution
+from .joints import coordinate_rates
+
+#: float arrays in buffer order, with their shapes in terms of the sizes below
+FLOATS = ("gravity", "axis", "pos", "C", "mass", "com", "inertia", "load_point", "load_force",
+          "load_moment", "react_force", "react_moment", "qfull", "ufull", "udfull", "R", "r",
+          "w", "v", "alpha", "a", "JR", "JT", "F", "N", "M", "f", "L", "A", "b", "ud")
+#: integer arrays in buffer order (the two flag arrays are stored as 0/1)
+INTS = ("parent", "kind", "seq", "qoff", "uoff", "ucol", "anc_ptr", "anc_idx", "has_inertia",
+        "load_body", "load_in_body", "react_joint", "free_q", "free_u", "slots")
+#: sizes, first entries of the offset table: frames, free speeds, loads, joint-space
+#: coordinates and speeds, ancestor-column entries, reaction components, free coordinates,
+#: free joints
+SIZES = ("n", "nu", "nl", "nqf", "nuf", "nanc", "nreact", "nq", "nslots")
+
+(GRAVITY, AXIS, POS, C, MASS, COM, INERTIA, LOAD_POINT, LOAD_FORCE, LOAD_MOMENT, REACT_FORCE,
+ REACT_MOMENT, QFULL, UFULL, UDFULL, R, RR, W, V, ALPHA, A, JR, JT, F, N, M, FF, L, AA, B,
+ UD) = range(len(SIZES), len(SIZES) + len(FLOATS))
+(PARENT, KIND, SEQ, QOFF, UOFF, UCOL, ANC_PTR, ANC_IDX, HAS_INERTIA, LOAD_BODY, LOAD_IN_BODY,
+ REACT_JOINT, FREE_Q, FREE_U, SLOTS) = range(len(SIZES) + len(FLOATS), len(SIZES) + len(FLOATS) + len(INTS))
+
+
+def pack(floats, ints):
+    """Copy the arrays of ``floats`` and ``ints`` (dicts by the names in ``FLOATS``,
+    ``INTS``) into two buffers.  Returns ``(fbuf, ibuf, table, views)``: ``table`` holds the
+    sizes (``SIZES``) and then each array's offset; ``views[name]`` is the array's view."""
+    sizes = {"n": floats["mass"].shape[0], "nu": floats["M"].shape[0],
+             "nl": floats["load_force"].shape[0], "nqf": floats["qfull"].shape[0],
+             "nuf": floats["ufull"].shape[0], "nanc": ints["anc_idx"].shape[0],
+             "nreact": ints["react_joint"].shape[0], "nq": ints["free_q"].shape[0],
+             "nslots": ints["slots"].shape[0]}
+    table = np.zeros(len(SIZES) + len(FLOATS) + len(INTS), np.int64)
+    table[:len(SIZES)] = [sizes[s] for s in SIZES]
+    views = {}
+    for names, source, dtype in ((FLOATS, floats, np.float64), (INTS, ints, np.int64)):
+        first = len(SIZES) + (0 if names is FLOATS else len(FLOATS))
+        total = sum(np.asarray(source[k]).size for k in names)
+        buf = np.zeros(total, dtype)
+        at = 0
+        for k, name in enumerate(names):
+            arr = np.asarray(source[name])
+            table[first + k] = at
+            view = buf[at:at + arr.size].reshape(arr.shape)
+            view[...] = arr
+            views[name] = view if arr.dtype != np.bool_ else arr   # flags keep their bools
+            at += arr.size
+        if names is FLOATS:
+            fbuf = buf
+        else:
+            ibuf = buf
+    return fbuf, ibuf, table, views
+
+
+@njit(cache=True, inline="always")
+def _v1(buf, t, k, a):
+    return buf[t[k]:t[k] + a]
+
+
+@njit(cache=True, inline="always")
+def _v2(buf, t, k, a, b):
+    return buf[t[k]:t[k] + a * b].reshape((a, b))
+
+
+@njit(cache=True, inline="always")
+def _v3(buf, t, k, a, b, c):
+    return buf[t[k]:t[k] + a * b * c].reshape((a, b, c))
+
+
+@njit(cache=True)
+def _scatter(fb, ib, t, q, u):
+    """Free coordinates and speeds into the joint-space state; their rates ``u'`` to zero
+    (the Jourdain terms are evaluated at ``u' = 0``; driven entries are the caller's)."""
+    qfull, ufull, udfull = fb[t[QFULL]:], fb[t[UFULL]:], fb[t[UDFULL]:]
+    free_q, free_u = ib[t[FREE_Q]:], ib[t[FREE_U]:]
+    for k in range(q.shape[0]):
+        qfull[free_q[k]] = q[k]
+    for k in range(u.shape[0]):
+        ufull[free_u[k]] = u[k]
+        udfull[free_u[k]] = 0.0
+
+
+@njit(cache=True)
+def jourdain_accelerations_packed(fb, ib, t, q, u):
+    """Scatter ``q``, ``u``, then ``evaluate.jourdain_accelerations`` on packed arrays (same
+    return value; ``u'`` is left in the ``ud`` view)."""
+    _scatter(fb, ib, t, q, u)
+    return _jourdain(fb, ib, t)
+
+
+@njit(cache=True)
+def state_derivative_packed(fb, ib, t, y, ydot):
+    """``ydot = [N(q) u, u']`` for ``y = [q, u]``.  Returns -1, the pivot where the
+    Cholesky factorization of ``M`` broke down, or -2 when ``ydot`` holds NaN or Inf."""
+    nq, nu = t[7], t[1]
+    _scatter(fb, ib, t, y[:nq], y[nq:])
+    pivot = _jourdain(fb, ib, t)
+    if pivot >= 0:
+        return pivot
+    ud = fb[t[UD]:t[UD] + nu]
+    for k in range(nu):
+        ydot[nq + k] = ud[k]
+    coordinate_rates(y[:nq], y[nq:], _v2(ib, t, SLOTS, t[8], 5), ydot[:nq])
+    for k in range(ydot.shape[0]):
+        if not np.isfinite(ydot[k]):
+            return -2
+    return -1
+
+
+@njit(cache=True)
+def _jourdain(fb, ib, t):
+    n, nu, nl, nqf, nuf, nanc = t[0], t[1], t[2], t[3], t[4], t[5]
+    return jourdain_accelerations(
+        _v1(ib, t, PARENT, n), _v1(ib, t, KIND, n), _v2(fb, t, AXIS, n, 3),
+        _v2(ib, t, SEQ, n, 3), _v2(fb, t, POS, n, 3), _v3(fb, t, C, n, 3, 3),
+        _v1(ib, t, QOFF, n), _v1(ib, t, UOFF, n), _v1(ib, t, UCOL, n),
+        _v1(ib, t, ANC_PTR, n + 1), _v1(ib, t, ANC_IDX, nanc),
+        _v1(fb, t, MASS, n), _v2(fb, t, COM, n, 3), _v3(fb, t, INERTIA, n, 3, 3),
+        _v1(ib, t, HAS_INERTIA, n) != 0, _v1(fb, t, GRAVITY, 3),
+        _v1(fb, t, QFULL, nqf), _v1(fb, t, UFULL, nuf), _v1(fb, t, UDFULL, nuf),
+        _v1(ib, t, LOAD_BODY, nl), _v2(fb, t, LOAD_POINT, nl, 3),
+        _v2(fb, t, LOAD_FORCE, nl, 3), _v2(fb, t, LOAD_MOMENT, nl, 3),
+        _v1(ib, t, LOAD_IN_BODY, nl) != 0,
+        _v3(fb, t, R, n, 3, 3), _v2(fb, t, RR, n, 3), _v2(fb, t, W, n, 3),
+        _v2(fb, t, V, n, 3), _v2(fb, t, ALPHA, n, 3), _v2(fb, t, A, n, 3),
+        _v3(fb, t, JR, n, 3, nu), _v3(fb, t, JT, n, 3, nu), _v2(fb, t, F, n, 3),
+        _v2(fb, t, N, n, 3), _v2(fb, t, M, nu, nu), _v1(fb, t, FF, nu),
+        _v2(fb, t, L, nu, nu), _v1(fb, t, UD, nu))
+
+
+@njit(cache=True)
+def newton_euler_solution_packed(fb, ib, t):
+    """``evaluate.newton_euler_solution`` on packed arrays (same return value)."""
+    n, nu, nl, nqf, nuf, nanc, nreact = t[0], t[1], t[2], t[3], t[4], t[5], t[6]
+    return newton_euler_solution(
+        _v1(ib, t, PARENT, n), _v1(ib, t, KIND, n), _v2(fb, t, AXIS, n, 3),
+        _v2(ib, t, SEQ, n, 3), _v2(fb, t, POS, n, 3), _v3(fb, t, C, n, 3, 3),
+        _v1(ib, t, QOFF, n), _v1(ib, t, UOFF, n), _v1(ib, t, UCOL, n),
+        _v1(ib, t, ANC_PTR, n + 1), _v1(ib, t, ANC_IDX, nanc),
+        _v1(fb, t, MASS, n), _v2(fb, t, COM, n, 3), _v3(fb, t, INERTIA, n, 3, 3),
+        _v1(fb, t, GRAVITY, 3),
+        _v1(fb, t, QFULL, nqf), _v1(fb, t, UFULL, nuf), _v1(fb, t, UDFULL, nuf),
+        _v1(ib, t, LOAD_BODY, nl), _v2(fb, t, LOAD_POINT, nl, 3),
+        _v2(fb, t, LOAD_FORCE, nl, 3), _v2(fb, t, LOAD_MOMENT, nl, 3),
+        _v1(ib, t, LOAD_IN_BODY, nl) != 0,
+        _v1(ib, t, REACT_JOINT, nreact), _v2(fb, t, REACT_FORCE, nreact, 3),
+        _v2(fb, t, REACT_MOMENT, nreact, 3),
+        _v3(fb, t, R, n, 3, 3), _v2(fb, t, RR, n, 3), _v2(fb, t, W, n, 3),
+        _v2(fb, t, V, n, 3), _v2(fb, t, ALPHA, n, 3), _v2(fb, t, A, n, 3),
+        _v3(fb, t, JR, n, 3, nu), _v3(fb, t, JT, n, 3, nu), _v2(fb, t, F, n, 3),
+        _v2(fb, t, N, n, 3), _v2(fb, t, AA, 6 * n, 6 * n), _v1(fb, t, B, 6 * n))
