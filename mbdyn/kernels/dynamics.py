@@ -21,11 +21,8 @@ def applied_loads(mass, com, gravity, R, r, load_body, load_point, load_force, l
     its force and moment are given in body (1) or world (0) components.
     """
     n = mass.shape[0]
-    f = np.empty(3)
-    mo = np.empty(3)
-    arm = np.empty(3)
-    lever = np.empty(3)
-    t = np.empty(3)
+    tmp = np.empty(15)                  # one allocation for the temporaries
+    f, mo, arm, lever, t = tmp[0:3], tmp[3:6], tmp[6:9], tmp[9:12], tmp[12:15]
     for i in range(n):
         for k in range(3):
             F[i, k] = mass[i] * gravity[k]
@@ -88,16 +85,14 @@ def jourdain(mass, com, inertia, has_inertia, R, r, w, alpha_b, a_b, JR, JT, anc
     composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc_idx, M)
     nu = M.shape[0]
     f[:] = 0.0
-    JG = np.zeros((3, nu))
-    c = np.empty(3)
-    Iw = np.empty((3, 3))
-    S3 = np.empty((3, 3))
-    aG_b = np.empty(3)
-    gyro = np.empty(3)
-    t1 = np.empty(3)
-    t2 = np.empty(3)
-    fT = np.empty(3)
-    fR = np.empty(3)
+    tmp = np.empty(3 * nu + 18 + 21)   # one allocation for the temporaries
+    JG = tmp[:3 * nu].reshape((3, nu))
+    JG[:, :] = 0.0
+    Iw = tmp[3 * nu:3 * nu + 9].reshape((3, 3))
+    S3 = tmp[3 * nu + 9:3 * nu + 18].reshape((3, 3))
+    at = 3 * nu + 18
+    c, aG_b, gyro, t1 = tmp[at:at + 3], tmp[at + 3:at + 6], tmp[at + 6:at + 9], tmp[at + 9:at + 12]
+    t2, fT, fR = tmp[at + 12:at + 15], tmp[at + 15:at + 18], tmp[at + 18:at + 21]
     for i in range(mass.shape[0]):
         if not has_inertia[i]:
             loaded = False
@@ -130,11 +125,14 @@ def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc
     """
     n = mass.shape[0]
     nu = M.shape[0]
-    S = np.empty((nu, 6))
-    IC = np.zeros((n, 6, 6))
-    Iw = np.empty((3, 3))
-    S3 = np.empty((3, 3))
-    c = np.empty(3)
+    tmp = np.empty(6 * nu + 36 * n + 27)   # one allocation for the temporaries
+    S = tmp[:6 * nu].reshape((nu, 6))
+    IC = tmp[6 * nu:6 * nu + 36 * n].reshape((n, 6, 6))
+    IC[:, :, :] = 0.0
+    at = 6 * nu + 36 * n
+    Iw = tmp[at:at + 9].reshape((3, 3))
+    S3 = tmp[at + 9:at + 18].reshape((3, 3))
+    c, Fc = tmp[at + 18:at + 21], tmp[at + 21:at + 27]
     M[:, :] = 0.0
     for i in range(n):
         # this frame's own columns come last in its (sorted) column list: columns are
@@ -178,7 +176,6 @@ def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc
             for a_ in range(6):
                 for b_ in range(6):
                     IC[p, a_, b_] += IC[i, a_, b_]
-    Fc = np.empty(6)
     for i in range(n):
         p = parent[i]
         inherited = anc_ptr[p + 1] - anc_ptr[p] if p >= 0 else 0
