@@ -355,8 +355,13 @@ class Model:
         return drift
 
     def quaternion_drift(self, q):
-        """Largest ``| |quat| - 1 |`` over the joint quaternions in ``q`` (0 if none)."""
-        return max((abs(np.linalg.norm(q[s]) - 1.0) for s in self._quaternions), default=0.0)
+        """Largest ``| |quat| - 1 |`` over the joint quaternions in ``q`` (0 if none); ``q``
+        one state or an array of states (one per row)."""
+        q = np.asarray(q, dtype=float)
+        if not self._quaternions or not q.size:
+            return 0.0
+        return float(max(np.abs(np.linalg.norm(q[..., s], axis=-1) - 1.0).max()
+                         for s in self._quaternions))
 
     # ------------------------------------------------------------------ evaluation core
     def _fill(self, q, u, t):

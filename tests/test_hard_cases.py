@@ -232,3 +232,37 @@ def test_fixed_step_quaternions_stay_on_the_unit_sphere_and_drift_is_reported():
         res = mb.simulate(model, 0.5, q0, [0.5, 0.3, 40.0], integrator=integrator, dt=1e-3)
         assert np.allclose(np.linalg.norm(res.q, axis=1), 1.0, atol=1e-14), integrator
         assert "quaternion_drift" in res.stats
+
+
+@pytest.mark.parametrize("stretches", [1, 3])
+def test_vectorized_singularity_watch_matches_the_step_by_step_one(stretches):
+    """Fixed-step runs check whole stretches of steps at once (``check_rows``); it must
+    stop at the same row, with the same message, closest approach and warnings, as the
+    one-step check the adaptive runs use."""
+    from mbdyn.simulate import _Monitor
+    model = top("euler")
+    ts = np.linspace(0.0, 0.1, 100)
+    ys = np.zeros((100, 6))
+    ys[:, 1] = np.linspace(0.3, -0.1, 100)          # theta passes 0 between two rows
+    step, vector = _Monitor(model, 1e-6), _Monitor(model, 1e-6)
+    with warnings.catch_warnings(record=True) as w_step:
+        warnings.simplefilter("always")
+        n_step, f_step = len(ts), None
+        for i in range(len(ts)):
+            f_step = step.check(ts[i], ys[i])
+            if f_step:
+                n_step = i
+                break
+    with warnings.catch_warnings(record=True) as w_vector:
+        warnings.simplefilter("always")
+        n_vector, f_vector = 0, None
+        for chunk in np.array_split(np.arange(len(ts)), stretches):
+            n, f_vector = vector.check_rows(ts[chunk], ys[chunk])
+            n_vector += n
+            if f_vector:
+                break
+    assert f_step is not None and "between t=" in f_step
+    assert (n_vector, f_vector) == (n_step, f_step)
+    assert vector.closest == pytest.approx(step.closest)
+    assert [str(x.message) for x in w_vector] == [str(x.message) for x in w_step]
+    assert len(w_step) == 1
