@@ -309,13 +309,13 @@ class Raw:
             self.jargs = packed_args(model, q, u)
             self.ud = model._ud
             self.prebuilt = True
-            self.neargs = model._packed
+            self.neargs = self.jargs
             self.jk = kp.jourdain_accelerations_packed
             self.nek = kp.newton_euler_solution_packed
             ref = model.forward_dynamics(q, u, 0.0, method="jourdain")
             model._fill(q, u, 0.0)
             pivot = self.jk(*self.jargs)
-            x = self.nek(*self.neargs)
+            x, _ = self.nek(*self.neargs)
             scale = max(np.abs(ref).max(), 1.0)
             if pivot >= 0 or np.abs(self.ud - ref).max() > 1e-9 * scale \
                     or np.abs(x[:model.nu] - ref).max() > 1e-6 * scale:

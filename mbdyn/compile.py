@@ -524,14 +524,18 @@ class Model:
         return ydot
 
     def _newton_euler(self, q, u, t):
-        q, u = self._fill(q, u, t)
+        q, u = self._state(q, u)
+        if self._python_inputs:
+            self._fill_inputs(q, u, t)
         try:
-            x = kp.newton_euler_solution_packed(*self._packed)
-        except np.linalg.LinAlgError:
+            x, finite = kp.newton_euler_solution_packed(*self._packed, q, u)
+        except np.linalg.LinAlgError:     # singular, or fed NaN/Inf: tell which
             self._jourdain_terms(q, u, t)
+            for out in (self._f, np.diag(self._M)):
+                if not np.all(np.isfinite(out)):
+                    self._check_finite(q, u, t, out, "the Newton-Euler equations")
             self._raise_singular(q, t, None)
-        total = x.sum()
-        if not total - total == 0.0:      # NaN or Inf somewhere: find and report it
+        if not finite:                    # NaN or Inf somewhere: find and report it
             self._check_finite(q, u, t, x, "the Newton-Euler solution")
         return x
 

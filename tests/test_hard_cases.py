@@ -209,6 +209,23 @@ def test_nan_from_a_load_stops_the_run_with_time_state_and_element():
         assert np.all(np.isfinite(kept.q)) and np.all(np.isfinite(kept.u))
 
 
+@pytest.mark.parametrize("method", ["jourdain", "newton-euler"])
+def test_both_formulations_name_a_non_finite_load_and_a_missing_inertia(method):
+    s = mb.System("pendulum")
+    s.add_body("bob", mass=1.0, com=(0, 0, -1))
+    s.add_joint("beta", "revolute", "ground", "bob", axis="x")
+    s.add_load("kick", "bob", force=lambda t, q, u: (np.inf if t > 0.5 else 0.0, 0.0, 0.0))
+    model = s.compile()
+    assert np.all(np.isfinite(model.forward_dynamics([0.2], [0.0], 0.4, method=method)))
+    with pytest.raises(mb.NonFiniteError, match=r"t=0\.6: load 'kick' returned non-finite"):
+        model.forward_dynamics([0.2], [0.0], 0.6, method=method)
+    s.add_body("bead", mass=1.0)                 # a particle spinning about its own axis
+    s.add_joint("spin", "revolute", parent="bob", child="bead", axis="z")
+    model = s.compile(check_inertia=False)
+    with pytest.raises(mb.SingularMassMatrixError, match=r"spin \(joint 'spin'\)"):
+        model.forward_dynamics([0.2, 0.0], [0.0, 0.0], 0.0, method=method)
+
+
 def test_failing_integrator_keeps_the_results_before_the_failure():
     """A load that turns singular in finite time (1/(t_s - t)): the step size underflows."""
     s = mb.System("blow-up")

@@ -145,8 +145,19 @@ def _jourdain(fb, ib, t):
 
 
 @njit(cache=True)
-def newton_euler_solution_packed(fb, ib, t):
-    """``evaluate.newton_euler_solution`` on packed arrays (same return value)."""
+def newton_euler_solution_packed(fb, ib, t, q, u):
+    """Scatter ``q``, ``u``, then ``evaluate.newton_euler_solution`` on packed arrays.
+    Returns the unknowns ``x = [ud, lambda]`` (a new array) and whether all are finite."""
+    _scatter(fb, ib, t, q, u)
+    x = _newton_euler(fb, ib, t)
+    finite = True
+    for k in range(x.shape[0]):
+        finite = finite and np.isfinite(x[k])
+    return x, finite
+
+
+@njit(cache=True)
+def _newton_euler(fb, ib, t):
     n, nu, nl, nqf, nuf, nanc, nreact = t[0], t[1], t[2], t[3], t[4], t[5], t[6]
     return newton_euler_solution(
         _v1(ib, t, PARENT, n), _v1(ib, t, KIND, n), _v2(fb, t, AXIS, n, 3),
