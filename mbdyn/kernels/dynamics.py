@@ -85,14 +85,12 @@ def jourdain(mass, com, inertia, has_inertia, R, r, w, alpha_b, a_b, JR, JT, anc
     composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc_idx, M)
     nu = M.shape[0]
     f[:] = 0.0
-    tmp = np.empty(3 * nu + 18 + 21)   # one allocation for the temporaries
-    JG = tmp[:3 * nu].reshape((3, nu))
-    JG[:, :] = 0.0
-    Iw = tmp[3 * nu:3 * nu + 9].reshape((3, 3))
-    S3 = tmp[3 * nu + 9:3 * nu + 18].reshape((3, 3))
-    at = 3 * nu + 18
-    c, aG_b, gyro, t1 = tmp[at:at + 3], tmp[at + 3:at + 6], tmp[at + 6:at + 9], tmp[at + 9:at + 12]
-    t2, fT, fR = tmp[at + 12:at + 15], tmp[at + 15:at + 18], tmp[at + 18:at + 21]
+    JG = np.zeros((3, nu))
+    Iw = np.empty((3, 3))
+    S3 = np.empty((3, 3))
+    tmp = np.empty(21)                  # the vector temporaries share one allocation
+    c, aG_b, gyro, t1 = tmp[0:3], tmp[3:6], tmp[6:9], tmp[9:12]
+    t2, fT, fR = tmp[12:15], tmp[15:18], tmp[18:21]
     for i in range(mass.shape[0]):
         if not has_inertia[i]:
             loaded = False
@@ -125,14 +123,12 @@ def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc
     """
     n = mass.shape[0]
     nu = M.shape[0]
-    tmp = np.empty(6 * nu + 36 * n + 27)   # one allocation for the temporaries
-    S = tmp[:6 * nu].reshape((nu, 6))
-    IC = tmp[6 * nu:6 * nu + 36 * n].reshape((n, 6, 6))
-    IC[:, :, :] = 0.0
-    at = 6 * nu + 36 * n
-    Iw = tmp[at:at + 9].reshape((3, 3))
-    S3 = tmp[at + 9:at + 18].reshape((3, 3))
-    c, Fc = tmp[at + 18:at + 21], tmp[at + 21:at + 27]
+    S = np.empty((nu, 6))
+    IC = np.zeros((n, 6, 6))
+    Iw = np.empty((3, 3))
+    S3 = np.empty((3, 3))
+    tmp = np.empty(9)                   # the vector temporaries share one allocation
+    c, Fc = tmp[0:3], tmp[3:9]
     M[:, :] = 0.0
     for i in range(n):
         # this frame's own columns come last in its (sorted) column list: columns are

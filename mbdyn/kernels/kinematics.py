@@ -38,25 +38,18 @@ def forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_pt
     ``JT[i]`` are zero and are never written, so the caller zeroes them once.
     """
     n = parent.shape[0]
-    # one allocation for all the temporaries (each np.empty costs about 40 ns)
-    tmp = np.empty(2 * 9 + 2 * 3 * MAX_NU + 36 + 24 + 14 * 3)
-    Rrel = tmp[0:9].reshape((3, 3))
-    RJ0 = tmp[9:18].reshape((3, 3))
-    at = 18
-    Hw = tmp[at:at + 3 * MAX_NU].reshape((3, MAX_NU))
-    Hv = tmp[at + 3 * MAX_NU:at + 6 * MAX_NU].reshape((3, MAX_NU))
-    at += 6 * MAX_NU
-    Sm = tmp[at:at + 36].reshape((4, 3, 3))
-    Sv = tmp[at + 36:at + 60].reshape((8, 3))
-    at += 60
-    d, hw, hv, rho = tmp[at:at + 3], tmp[at + 3:at + 6], tmp[at + 6:at + 9], tmp[at + 9:at + 12]
-    at += 12
-    wrel_b, dwrel_b = tmp[at:at + 3], tmp[at + 3:at + 6]
-    vrel_j, dvrel_j = tmp[at + 6:at + 9], tmp[at + 9:at + 12]
-    at += 12
-    wrel, vrel, t1, t2 = tmp[at:at + 3], tmp[at + 3:at + 6], tmp[at + 6:at + 9], tmp[at + 9:at + 12]
-    at += 12
-    t3, t4 = tmp[at:at + 3], tmp[at + 3:at + 6]
+    Rrel = np.empty((3, 3))
+    RJ0 = np.empty((3, 3))
+    Hw = np.empty((3, MAX_NU))
+    Hv = np.empty((3, MAX_NU))
+    Sm = np.empty((4, 3, 3))
+    Sv = np.empty((8, 3))
+    # the vector temporaries share one allocation (each np.empty costs about 40 ns)
+    tmp = np.empty(14 * 3)
+    d, hw, hv, rho = tmp[0:3], tmp[3:6], tmp[6:9], tmp[9:12]
+    wrel_b, dwrel_b, vrel_j, dvrel_j = tmp[12:15], tmp[15:18], tmp[18:21], tmp[21:24]
+    wrel, vrel, t1, t2 = tmp[24:27], tmp[27:30], tmp[30:33], tmp[33:36]
+    t3, t4 = tmp[36:39], tmp[39:42]
     for i in range(n):
         p = parent[i]
         k0 = qoff[i]

@@ -68,19 +68,47 @@ def pack(floats, ints):
     return fbuf, ibuf, table, views
 
 
-@njit(cache=True, inline="always")
-def _v1(buf, t, k, a):
-    return buf[t[k]:t[k] + a]
-
-
-@njit(cache=True, inline="always")
-def _v2(buf, t, k, a, b):
-    return buf[t[k]:t[k] + a * b].reshape((a, b))
-
-
-@njit(cache=True, inline="always")
-def _v3(buf, t, k, a, b, c):
-    return buf[t[k]:t[k] + a * b * c].reshape((a, b, c))
+@njit(cache=True)
+def _views(fb, ib, t):
+    """Every packed array as a view, in the order of the unpacked kernels' arguments:
+    tree (11), body (mass, com, inertia, has_inertia, gravity), joint-space state (3),
+    loads (5), reactions (3), motion (10), Jourdain (M, f, L, ud), Newton-Euler (A, b).
+    Offsets are read from ``t`` at run time: literal constants as arguments would make
+    numba compile a slicing helper per constant."""
+    n, nu, nl, nqf, nuf, nanc, nreact = t[0], t[1], t[2], t[3], t[4], t[5], t[6]
+    tree = (ib[t[PARENT]:t[PARENT] + n], ib[t[KIND]:t[KIND] + n],
+            fb[t[AXIS]:t[AXIS] + 3 * n].reshape((n, 3)),
+            ib[t[SEQ]:t[SEQ] + 3 * n].reshape((n, 3)),
+            fb[t[POS]:t[POS] + 3 * n].reshape((n, 3)),
+            fb[t[C]:t[C] + 9 * n].reshape((n, 3, 3)),
+            ib[t[QOFF]:t[QOFF] + n], ib[t[UOFF]:t[UOFF] + n], ib[t[UCOL]:t[UCOL] + n],
+            ib[t[ANC_PTR]:t[ANC_PTR] + n + 1], ib[t[ANC_IDX]:t[ANC_IDX] + nanc])
+    body = (fb[t[MASS]:t[MASS] + n], fb[t[COM]:t[COM] + 3 * n].reshape((n, 3)),
+            fb[t[INERTIA]:t[INERTIA] + 9 * n].reshape((n, 3, 3)),
+            ib[t[HAS_INERTIA]:t[HAS_INERTIA] + n] != 0, fb[t[GRAVITY]:t[GRAVITY] + 3])
+    state = (fb[t[QFULL]:t[QFULL] + nqf], fb[t[UFULL]:t[UFULL] + nuf],
+             fb[t[UDFULL]:t[UDFULL] + nuf])
+    loads = (ib[t[LOAD_BODY]:t[LOAD_BODY] + nl],
+             fb[t[LOAD_POINT]:t[LOAD_POINT] + 3 * nl].reshape((nl, 3)),
+             fb[t[LOAD_FORCE]:t[LOAD_FORCE] + 3 * nl].reshape((nl, 3)),
+             fb[t[LOAD_MOMENT]:t[LOAD_MOMENT] + 3 * nl].reshape((nl, 3)),
+             ib[t[LOAD_IN_BODY]:t[LOAD_IN_BODY] + nl] != 0)
+    reactions = (ib[t[REACT_JOINT]:t[REACT_JOINT] + nreact],
+                 fb[t[REACT_FORCE]:t[REACT_FORCE] + 3 * nreact].reshape((nreact, 3)),
+                 fb[t[REACT_MOMENT]:t[REACT_MOMENT] + 3 * nreact].reshape((nreact, 3)))
+    motion = (fb[t[R]:t[R] + 9 * n].reshape((n, 3, 3)),
+              fb[t[RR]:t[RR] + 3 * n].reshape((n, 3)), fb[t[W]:t[W] + 3 * n].reshape((n, 3)),
+              fb[t[V]:t[V] + 3 * n].reshape((n, 3)),
+              fb[t[ALPHA]:t[ALPHA] + 3 * n].reshape((n, 3)),
+              fb[t[A]:t[A] + 3 * n].reshape((n, 3)),
+              fb[t[JR]:t[JR] + 3 * n * nu].reshape((n, 3, nu)),
+              fb[t[JT]:t[JT] + 3 * n * nu].reshape((n, 3, nu)),
+              fb[t[F]:t[F] + 3 * n].reshape((n, 3)), fb[t[N]:t[N] + 3 * n].reshape((n, 3)))
+    jourdain = (fb[t[M]:t[M] + nu * nu].reshape((nu, nu)), fb[t[FF]:t[FF] + nu],
+                fb[t[L]:t[L] + nu * nu].reshape((nu, nu)), fb[t[UD]:t[UD] + nu])
+    newton_euler = (fb[t[AA]:t[AA] + 36 * n * n].reshape((6 * n, 6 * n)),
+                    fb[t[B]:t[B] + 6 * n])
+    return tree, body, state, loads, reactions, motion, jourdain, newton_euler
 
 
 @njit(cache=True)
@@ -101,7 +129,8 @@ def jourdain_accelerations_packed(fb, ib, t, q, u):
     """Scatter ``q``, ``u``, then ``evaluate.jourdain_accelerations`` on packed arrays (same
     return value; ``u'`` is left in the ``ud`` view)."""
     _scatter(fb, ib, t, q, u)
-    return _jourdain(fb, ib, t)
+    tree, body, state, loads, _, motion, jourdain, _ = _views(fb, ib, t)
+    return jourdain_accelerations(*tree, *body, *state, *loads, *motion, *jourdain)
 
 
 @njit(cache=True)
@@ -110,13 +139,15 @@ def state_derivative_packed(fb, ib, t, y, ydot):
     Cholesky factorization of ``M`` broke down, or -2 when ``ydot`` holds NaN or Inf."""
     nq, nu = t[7], t[1]
     _scatter(fb, ib, t, y[:nq], y[nq:])
-    pivot = _jourdain(fb, ib, t)
+    tree, body, state, loads, _, motion, jourdain, _ = _views(fb, ib, t)
+    pivot = jourdain_accelerations(*tree, *body, *state, *loads, *motion, *jourdain)
     if pivot >= 0:
         return pivot
-    ud = fb[t[UD]:t[UD] + nu]
+    ud = jourdain[3]
     for k in range(nu):
         ydot[nq + k] = ud[k]
-    coordinate_rates(y[:nq], y[nq:], _v2(ib, t, SLOTS, t[8], 5), ydot[:nq])
+    coordinate_rates(y[:nq], y[nq:], ib[t[SLOTS]:t[SLOTS] + 5 * t[8]].reshape((t[8], 5)),
+                     ydot[:nq])
     for k in range(ydot.shape[0]):
         if not np.isfinite(ydot[k]):
             return -2
@@ -124,55 +155,15 @@ def state_derivative_packed(fb, ib, t, y, ydot):
 
 
 @njit(cache=True)
-def _jourdain(fb, ib, t):
-    n, nu, nl, nqf, nuf, nanc = t[0], t[1], t[2], t[3], t[4], t[5]
-    return jourdain_accelerations(
-        _v1(ib, t, PARENT, n), _v1(ib, t, KIND, n), _v2(fb, t, AXIS, n, 3),
-        _v2(ib, t, SEQ, n, 3), _v2(fb, t, POS, n, 3), _v3(fb, t, C, n, 3, 3),
-        _v1(ib, t, QOFF, n), _v1(ib, t, UOFF, n), _v1(ib, t, UCOL, n),
-        _v1(ib, t, ANC_PTR, n + 1), _v1(ib, t, ANC_IDX, nanc),
-        _v1(fb, t, MASS, n), _v2(fb, t, COM, n, 3), _v3(fb, t, INERTIA, n, 3, 3),
-        _v1(ib, t, HAS_INERTIA, n) != 0, _v1(fb, t, GRAVITY, 3),
-        _v1(fb, t, QFULL, nqf), _v1(fb, t, UFULL, nuf), _v1(fb, t, UDFULL, nuf),
-        _v1(ib, t, LOAD_BODY, nl), _v2(fb, t, LOAD_POINT, nl, 3),
-        _v2(fb, t, LOAD_FORCE, nl, 3), _v2(fb, t, LOAD_MOMENT, nl, 3),
-        _v1(ib, t, LOAD_IN_BODY, nl) != 0,
-        _v3(fb, t, R, n, 3, 3), _v2(fb, t, RR, n, 3), _v2(fb, t, W, n, 3),
-        _v2(fb, t, V, n, 3), _v2(fb, t, ALPHA, n, 3), _v2(fb, t, A, n, 3),
-        _v3(fb, t, JR, n, 3, nu), _v3(fb, t, JT, n, 3, nu), _v2(fb, t, F, n, 3),
-        _v2(fb, t, N, n, 3), _v2(fb, t, M, nu, nu), _v1(fb, t, FF, nu),
-        _v2(fb, t, L, nu, nu), _v1(fb, t, UD, nu))
-
-
-@njit(cache=True)
 def newton_euler_solution_packed(fb, ib, t, q, u):
     """Scatter ``q``, ``u``, then ``evaluate.newton_euler_solution`` on packed arrays.
     Returns the unknowns ``x = [ud, lambda]`` (a new array) and whether all are finite."""
     _scatter(fb, ib, t, q, u)
-    x = _newton_euler(fb, ib, t)
+    tree, body, state, loads, reactions, motion, _, newton_euler = _views(fb, ib, t)
+    mass, com, inertia, _, gravity = body
+    x = newton_euler_solution(*tree, mass, com, inertia, gravity, *state, *loads,
+                              *reactions, *motion, *newton_euler)
     finite = True
     for k in range(x.shape[0]):
         finite = finite and np.isfinite(x[k])
     return x, finite
-
-
-@njit(cache=True)
-def _newton_euler(fb, ib, t):
-    n, nu, nl, nqf, nuf, nanc, nreact = t[0], t[1], t[2], t[3], t[4], t[5], t[6]
-    return newton_euler_solution(
-        _v1(ib, t, PARENT, n), _v1(ib, t, KIND, n), _v2(fb, t, AXIS, n, 3),
-        _v2(ib, t, SEQ, n, 3), _v2(fb, t, POS, n, 3), _v3(fb, t, C, n, 3, 3),
-        _v1(ib, t, QOFF, n), _v1(ib, t, UOFF, n), _v1(ib, t, UCOL, n),
-        _v1(ib, t, ANC_PTR, n + 1), _v1(ib, t, ANC_IDX, nanc),
-        _v1(fb, t, MASS, n), _v2(fb, t, COM, n, 3), _v3(fb, t, INERTIA, n, 3, 3),
-        _v1(fb, t, GRAVITY, 3),
-        _v1(fb, t, QFULL, nqf), _v1(fb, t, UFULL, nuf), _v1(fb, t, UDFULL, nuf),
-        _v1(ib, t, LOAD_BODY, nl), _v2(fb, t, LOAD_POINT, nl, 3),
-        _v2(fb, t, LOAD_FORCE, nl, 3), _v2(fb, t, LOAD_MOMENT, nl, 3),
-        _v1(ib, t, LOAD_IN_BODY, nl) != 0,
-        _v1(ib, t, REACT_JOINT, nreact), _v2(fb, t, REACT_FORCE, nreact, 3),
-        _v2(fb, t, REACT_MOMENT, nreact, 3),
-        _v3(fb, t, R, n, 3, 3), _v2(fb, t, RR, n, 3), _v2(fb, t, W, n, 3),
-        _v2(fb, t, V, n, 3), _v2(fb, t, ALPHA, n, 3), _v2(fb, t, A, n, 3),
-        _v3(fb, t, JR, n, 3, nu), _v3(fb, t, JT, n, 3, nu), _v2(fb, t, F, n, 3),
-        _v2(fb, t, N, n, 3), _v2(fb, t, AA, 6 * n, 6 * n), _v1(fb, t, B, 6 * n))
