@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import mbdyn as mb
+from random_trees import quat_mul
 from textbook_systems import TOP_DATA, double_pendulum_system
 
 M_TOP, H_TOP = TOP_DATA["m"], TOP_DATA["h"]
@@ -37,14 +38,7 @@ def zxz_quaternion(psi, theta, phi):
         v[1 + axis] = np.sin(a / 2)
         return v
 
-    def mul(a, b):
-        w1, x1, y1, z1 = a
-        w2, x2, y2, z2 = b
-        return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-                         w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-                         w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-                         w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
-    return mul(mul(q(2, psi), q(0, theta)), q(2, phi))
+    return quat_mul(quat_mul(q(2, psi), q(0, theta)), q(2, phi))
 
 
 # A top that swings through the vertical: thrown at theta = 0.3 rad towards it at 6 rad/s

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import mbdyn as mb
-from random_trees import cached_tree, quat_mul, quat_to_matrix, skew
+from random_trees import axis_rotation, cached_tree, quat_mul, quat_to_matrix, skew
 
 SEEDS = range(30)
 H = 1e-6
@@ -140,18 +140,15 @@ def test_coordinate_rates(seed):
 
 # ----------------------------------------------------------------------------- joint by joint
 def Rz(a):
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+    return axis_rotation(2, a)
 
 
 def Rx(a):
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+    return axis_rotation(0, a)
 
 
 def Ry(a):
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+    return axis_rotation(1, a)
 
 
 def Tz(a):

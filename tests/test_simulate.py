@@ -14,8 +14,8 @@ import pytest
 from scipy import integrate, special
 
 import mbdyn as mb
-from random_trees import (energy_of, matrix_to_quat, quat_to_matrix, random_rotation,
-                          random_tree)
+from random_trees import (axis_rotation, energy_of, matrix_to_quat, quat_to_matrix,
+                          random_rotation, random_tree)
 
 G = 9.81
 
@@ -341,13 +341,11 @@ TOP = dict(m=0.582, h=0.0558, A=0.00209393, C=0.00220580, Mz=-0.025)
 
 
 def Rz(a):
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+    return axis_rotation(2, a)
 
 
 def Rx(a):
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+    return axis_rotation(0, a)
 
 
 def top(kind):
