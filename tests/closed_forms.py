@@ -12,6 +12,8 @@ import math
 
 import numpy as np
 
+from random_trees import quat_mul
+
 G = 9.81
 
 
@@ -215,17 +217,10 @@ def top_body_rates(psi, theta, phi, dpsi, dtheta, dphi, ddpsi, ddtheta, ddphi):
 def quaternion_zxz(psi, theta, phi):
     """Unit quaternion ``(w, x, y, z)`` of ``Rot_z(psi) Rot_x(theta) Rot_z(phi)`` (the
     rotation mapping body components to inertial ones, ``I s = R B s``, ``R = T^T``)."""
-    def mul(p, q):
-        w1, x1, y1, z1 = p
-        w2, x2, y2, z2 = q
-        return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-                         w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-                         w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-                         w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
     qz1 = np.array([math.cos(psi / 2), 0.0, 0.0, math.sin(psi / 2)])
     qx = np.array([math.cos(theta / 2), math.sin(theta / 2), 0.0, 0.0])
     qz2 = np.array([math.cos(phi / 2), 0.0, 0.0, math.sin(phi / 2)])
-    return mul(mul(qz1, qx), qz2)
+    return quat_mul(quat_mul(qz1, qx), qz2)
 
 
 def quaternion_matrix(q):

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import mbdyn as mb
-from random_trees import quat_mul
+from closed_forms import quaternion_zxz
 from textbook_systems import TOP_DATA, double_pendulum_system
 
 M_TOP, H_TOP = TOP_DATA["m"], TOP_DATA["h"]
@@ -29,16 +29,6 @@ def top(joint):
     else:
         s.add_joint("contact", "spherical", "ground", "top")
     return s.compile()
-
-
-def zxz_quaternion(psi, theta, phi):
-    def q(axis, a):
-        v = np.zeros(4)
-        v[0] = np.cos(a / 2)
-        v[1 + axis] = np.sin(a / 2)
-        return v
-
-    return quat_mul(quat_mul(q(2, psi), q(0, theta)), q(2, phi))
 
 
 # A top that swings through the vertical: thrown at theta = 0.3 rad towards it at 6 rad/s
@@ -72,7 +62,7 @@ def test_euler_top_approaching_the_singularity_warns_first():
 
 def test_quaternion_top_passes_through_theta_zero_conserving_energy():
     model = top("spherical")
-    q0 = zxz_quaternion(0.0, 0.3, 0.0)
+    q0 = quaternion_zxz(0.0, 0.3, 0.0)
     res = mb.simulate(model, 10.0, q0, [-6.0, 0.0, 0.0], integrator="DOP853", rtol=1e-12,
                       atol=1e-12, outputs=("energy",))
     assert res.t[-1] == pytest.approx(10.0)
@@ -101,7 +91,7 @@ def test_quaternion_and_euler_top_agree_away_from_the_singularity():
     w_body = np.array([dps * np.sin(th) * np.sin(ph) + dth * np.cos(ph),
                        dps * np.sin(th) * np.cos(ph) - dth * np.sin(ph),
                        dps * np.cos(th) + dph])
-    rq = mb.simulate(mq, 1.0, zxz_quaternion(ps, th, ph), w_body, integrator="DOP853",
+    rq = mb.simulate(mq, 1.0, quaternion_zxz(ps, th, ph), w_body, integrator="DOP853",
                      rtol=1e-11, atol=1e-12, t_eval=np.linspace(0, 1, 51))
     for k in range(0, 51, 10):
         ke = me.kinematics(re.q[k], re.u[k])
@@ -238,7 +228,7 @@ def test_failing_integrator_keeps_the_results_before_the_failure():
 
 def test_fixed_step_quaternions_stay_on_the_unit_sphere_and_drift_is_reported():
     model = top("spherical")
-    q0 = zxz_quaternion(0.0, 0.5, 0.0)
+    q0 = quaternion_zxz(0.0, 0.5, 0.0)
     for integrator in ("euler", "rk4", "semi-implicit-euler", "implicit-midpoint"):
         res = mb.simulate(model, 0.5, q0, [0.5, 0.3, 40.0], integrator=integrator, dt=1e-3)
         assert np.allclose(np.linalg.norm(res.q, axis=1), 1.0, atol=1e-14), integrator

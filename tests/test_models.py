@@ -1,8 +1,7 @@
 """Every file in models/: it loads, runs, and shows its expected behaviour.
 
-The textbook's three examples are checked against the closed forms of EXAMPLES.md (taken
-from ``tests/closed_forms.py`` when it is there, otherwise from the transcription below)
-and against the text's own fixed-step scheme; the other models against their closed
+The textbook's three examples are checked against the closed forms of EXAMPLES.md (from
+``tests/closed_forms.py``) and against the text's own fixed-step scheme; the other models against their closed
 forms and conservation laws.
 """
 import math
@@ -21,74 +20,12 @@ MODELS = ROOT / "models"
 MODEL_FILES = sorted(MODELS.glob("*.toml"))
 pytestmark = pytest.mark.filterwarnings("ignore:.*triangle inequality")
 
-try:                                     # the shared, independent transcription
-    from closed_forms import double_pendulum as cf_double_pendulum
-    from closed_forms import double_pendulum_positions as cf_double_pendulum_positions
-    from closed_forms import rotating_pendulum as cf_rotating_pendulum
-    from closed_forms import top as cf_top
-    from closed_forms import top_contact_force_B2 as cf_top_contact_force_B2
-except ImportError:                      # pragma: no cover - our own transcription
-    def cf_rotating_pendulum(beta, beta_dot, t, Omega, omega, b, r, l, m, g=9.81):
-        W = Omega + omega
-        sb, cb = math.sin(beta), math.cos(beta)
-        K = b * Omega**2 * math.cos(omega * t) + r * W**2
-        return (-(g / l) * sb + K / l * cb + W**2 * sb * cb,
-                -m * (b * Omega**2 * math.sin(omega * t) + 2 * l * W * beta_dot * cb),
-                m * (g * cb + K * sb + l * (beta_dot**2 + W**2 * sb**2)))
-
-    def cf_double_pendulum(t1, t2, dt1, dt2, m1, m2, l1, l2, g=9.81):
-        S, C = math.sin, math.cos
-        den = -(l1 * l2 * m1 * m2) - l1 * l2 * m2**2 * S(t2)**2
-        ddt1 = (g * l2 * m1 * m2 * S(t1) - (dt1 + dt2)**2 * l2**2 * m2**2 * S(t2)
-                - dt1**2 * l1 * l2 * m2**2 * C(t2) * S(t2)
-                - g * l2 * m2**2 * C(t1 + t2) * S(t2)) / den
-        ddt2 = (-(g * l2 * m1 * m2 * S(t1)) - g * l1 * m1 * m2 * C(t2) * S(t1)
-                + dt1**2 * l1**2 * m1 * m2 * S(t2) + (dt1 + dt2)**2 * l2**2 * m2**2 * S(t2)
-                + (2 * dt1**2 + 2 * dt1 * dt2 + dt2**2) * l1 * l2 * m2**2 * C(t2) * S(t2)
-                + dt1**2 * l1**2 * m2**2 * C(t2)**2 * S(t2)
-                + g * l2 * m2**2 * C(t1 + t2) * S(t2)
-                + g * l1 * m2**2 * C(t2) * C(t1 + t2) * S(t2)
-                + dt1**2 * l1**2 * m2**2 * S(t2)**3 + g * l1 * m1 * m2 * S(t1 + t2)
-                + g * l1 * m2**2 * S(t2)**2 * S(t1 + t2)) / den
-        Tr1 = (-(dt1**2 * l1**2 * l2 * m1**2 * m2) - g * l1 * l2 * m1**2 * m2 * C(t1)
-               - (dt1 + dt2)**2 * l1 * l2**2 * m1 * m2**2 * C(t2)
-               - dt1**2 * l1**2 * l2 * m1 * m2**2 * (C(t2)**2 + S(t2)**2)
-               - g * l1 * l2 * m1 * m2**2 * C(t2) * C(t1 + t2)
-               - g * l1 * l2 * m1 * m2**2 * C(t2) * S(t1) * S(t2)
-               - g * l1 * l2 * m1 * m2**2 * C(t1) * S(t2)**2) / den
-        Tr2 = (-(dt1 + dt2)**2 * l1 * l2**2 * m1 * m2**2
-               - dt1**2 * l1**2 * l2 * m1 * m2**2 * C(t2)
-               - g * l1 * l2 * m1 * m2**2 * C(t1 + t2)
-               - g * l1 * l2 * m1 * m2**2 * S(t1) * S(t2)) / den
-        return ddt1, ddt2, Tr1, Tr2
-
-    def cf_double_pendulum_positions(t1, t2, l1, l2):
-        return (-l1 * math.sin(t1), -l1 * math.cos(t1),
-                -l1 * math.sin(t1) - l2 * math.sin(t1 + t2),
-                -(l1 * math.cos(t1) + l2 * math.cos(t1 + t2)))
-
-    def cf_top(psi, theta, phi, dpsi, dtheta, dphi, m, h, A, C, Mz, g=9.81):
-        s, c = math.sin(theta), math.cos(theta)
-        ddtheta = (m * g * h * s + dpsi**2 * (A - C) * s * c - C * dphi * dpsi * s) / A
-        ddpsi = (C * dpsi * dtheta * c - 2 * A * dpsi * dtheta * c + C * dphi * dtheta) / (A * s)
-        ddphi = -ddpsi * c + dpsi * dtheta * s + Mz / C
-        return ddpsi, ddtheta, ddphi
-
-    def cf_top_contact_force_B2(theta, dpsi, dtheta, ddpsi, ddtheta, m, h, g=9.81):
-        s, c = math.sin(theta), math.cos(theta)
-        aG = h * np.array([2 * dpsi * dtheta * c + ddpsi * s, dpsi**2 * s * c - ddtheta,
-                           -dpsi**2 * s**2 - dtheta**2])
-        return m * aG - np.array([0.0, -m * g * s, -m * g * c])
-
-
-def T_z(a):
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def T_x(a):
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, s], [0.0, -s, c]])
+from closed_forms import T_x, T_z
+from closed_forms import double_pendulum as cf_double_pendulum
+from closed_forms import double_pendulum_positions as cf_double_pendulum_positions
+from closed_forms import rotating_pendulum as cf_rotating_pendulum
+from closed_forms import top as cf_top
+from closed_forms import top_contact_force_B2 as cf_top_contact_force_B2
 
 
 # ----------------------------------------------------------------------------- all files
