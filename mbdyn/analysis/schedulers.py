@@ -1,0 +1,111 @@
+"""Where the members of a sweep run: one small interface, several engines.
+
+A scheduler is an object with ``map_unordered(fn, tasks)``: it calls the module-level
+function ``fn`` on each task (plain data: dicts, strings and numbers -- never closures)
+and yields ``(index, result)`` pairs in the order the tasks finish, and ``close()``.
+
+* ``"serial"``: in this process, in order.
+* ``"processes"``: a ``concurrent.futures`` pool of worker processes (spawned, so each
+  starts clean; numba's on-disk cache makes their compile a load).
+* ``"dask"``: a ``dask.distributed.LocalCluster`` of worker processes with one thread each
+  and no dashboard.
+* ``"tcp://HOST:PORT"``: an existing Dask scheduler.  Its workers must be able to
+  ``import mbdyn`` (the same version).
+"""
+from __future__ import annotations
+
+import os
+
+from ..errors import ModelError
+
+
+def make_scheduler(spec="serial", workers=None):
+    """The scheduler named by ``spec`` (see the module docstring); ``workers``: the number
+    of local worker processes (default: the number of cores)."""
+    if not isinstance(spec, str):
+        return spec                       # already a scheduler object
+    if spec == "serial":
+        return SerialScheduler()
+    if spec == "processes":
+        return ProcessScheduler(workers)
+    if spec == "dask" or spec.startswith("tcp://"):
+        return DaskScheduler(None if spec == "dask" else spec, workers)
+    raise ModelError(f"unknown scheduler {spec!r}; use serial, processes, dask or "
+                     "tcp://HOST:PORT (an existing Dask scheduler)")
+
+
+def _cores():
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+
+
+class SerialScheduler:
+    name = "serial"
+
+    def map_unordered(self, fn, tasks):
+        for i, task in enumerate(tasks):
+            yield i, fn(task)
+
+    def close(self):
+        pass
+
+
+class ProcessScheduler:
+    name = "processes"
+
+    def __init__(self, workers=None):
+        import concurrent.futures as cf
+        import multiprocessing as mp
+        self.workers = workers or _cores()
+        self.pool = cf.ProcessPoolExecutor(self.workers, mp_context=mp.get_context("spawn"))
+
+    def map_unordered(self, fn, tasks):
+        import concurrent.futures as cf
+        futures = {self.pool.submit(fn, task): i for i, task in enumerate(tasks)}
+        try:
+            for f in cf.as_completed(futures):
+                yield futures[f], f.result()
+        finally:
+            for f in futures:
+                f.cancel()
+
+    def close(self):
+        self.pool.shutdown(wait=True, cancel_futures=True)
+
+
+class DaskScheduler:
+    name = "dask"
+
+    def __init__(self, address=None, workers=None):
+        try:
+            from dask.distributed import Client, LocalCluster
+        except ImportError:
+            raise ModelError("the dask scheduler needs dask.distributed: "
+                             "pip install \"mbdyn[dask]\" (or dask[distributed])") from None
+        self.cluster = None
+        if address is None:
+            self.cluster = LocalCluster(n_workers=workers or _cores(), threads_per_worker=1,
+                                        processes=True, dashboard_address=None)
+            self.client = Client(self.cluster)
+        else:
+            try:
+                self.client = Client(address, timeout=30)
+            except OSError as exc:
+                raise ModelError(f"cannot reach the Dask scheduler at {address}: {exc}; "
+                                 "start one with `dask scheduler` and workers with "
+                                 f"`dask worker {address}`") from None
+            self.name = address
+
+    def map_unordered(self, fn, tasks):
+        from dask.distributed import as_completed
+        futures = [self.client.submit(fn, task, pure=False) for task in tasks]
+        index = {f.key: i for i, f in enumerate(futures)}
+        try:
+            for f in as_completed(futures):
+                yield index[f.key], f.result()
+        finally:
+            self.client.cancel([f for f in futures if not f.done()])
+
+    def close(self):
+        self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()

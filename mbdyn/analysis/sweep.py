@@ -1,0 +1,676 @@
+"""Parameter sweeps and ensembles: run one model file over a grid or a list of overrides
+and keep a few quantities of each member in a table.
+
+A *member* is plain data -- the model file's text, a case and ``(dotted path, value)``
+overrides as ``mbdyn run --set`` takes them -- so it can go to another process or machine
+(``schedulers``); each worker loads it with ``mbdyn.io.load_model`` and numba's on-disk
+cache makes the compile a load.  Rows are written to the CSV as members finish (flushed
+and synced), so an interrupted sweep keeps its finished members and ``resume=True``
+completes it; the table is sorted by member number, so it does not depend on the
+scheduler or on the order in which members finish.
+
+Quantities (``quantities=``; default ``("final", "events", "t_final")``):
+
+* ``"final"``: the final coordinates and speeds, columns ``final.NAME``;
+* ``"t_final"``: the time reached (a terminal event or a failure stops earlier);
+* ``"events"``: the time of each event's first occurrence, ``event.NAME`` (NaN: never);
+* ``"max:X"``, ``"min:X"``, ``"absmax:X"``, ``"mean:X"``, ``"std:X"`` of a coordinate or a
+  speed ``X`` (or ``energy``, the total T + V) over the motion, columns ``max.X`` ...;
+* ``"energy_drift"``: final minus initial total energy (J);
+* ``"steps"``, ``"rhs_evaluations"``.
+
+A member whose simulation fails keeps its row: ``status`` is ``failed`` and ``error``
+holds the reason; its quantities are those of the motion up to the failure.  A member
+whose overrides cannot be used has ``status = error``.
+
+Note on layers: members are model files, so running one imports ``mbdyn.io`` -- lazily,
+inside the worker function, the one place where *analysis* reaches up to *io*.
+"""
+from __future__ import annotations
+
+import csv
+import hashlib
+import io
+import itertools
+import json
+import math
+import os
+import sys
+import tempfile
+import time
+import warnings
+
+import numpy as np
+
+from ..errors import ModelError, SimulationError
+from .schedulers import make_scheduler
+
+DEFAULT_QUANTITIES = ("final", "events", "t_final")
+STATS = ("max", "min", "absmax", "mean", "std")
+SIMPLE = ("final", "events", "t_final", "energy_drift", "steps", "rhs_evaluations")
+FORMAT_LINE = "# mbdyn sweep table v1 spec="
+
+
+# --------------------------------------------------------------------------- the grid
+
+def parse_range(text, path="?"):
+    """The values of one grid axis from its text: ``START:STOP:N`` (N points, both ends
+    included), ``START:STOP:N:log`` (log spacing, same signs), a TOML array
+    ``[a, b, "pi/4"]`` or a single value."""
+    from ..io.schema import parse_set_value
+    text = str(text).strip()
+    if not text:
+        raise ModelError(f"grid {path}: the values are empty; give START:STOP:N or [a, b, ...]")
+    if text.startswith("["):
+        try:
+            values = parse_set_value(text)
+        except ValueError as exc:
+            raise ModelError(f"grid {path}={text}: {exc}") from None
+        if not isinstance(values, list):
+            raise ModelError(f"grid {path}={text}: not a list; write [a, b, ...] "
+                             "(strings in quotes)")
+        return values
+    if ":" in text:
+        parts = text.split(":")
+        how = "lin"
+        if len(parts) == 4:
+            how = parts.pop().strip()
+        if len(parts) != 3 or how not in ("lin", "log"):
+            raise ModelError(f"grid {path}={text}: a range is START:STOP:N or "
+                             "START:STOP:N:log, e.g. parameters.Mz=-0.03:-0.001:8")
+        try:
+            a, b = float(parts[0]), float(parts[1])
+            n = int(parts[2])
+        except ValueError:
+            raise ModelError(f"grid {path}={text}: START and STOP must be numbers and N a "
+                             "whole number, e.g. 0.1:0.5:5") from None
+        if n < 1:
+            raise ModelError(f"grid {path}={text}: N = {n} gives no members; use N >= 1")
+        if how == "log":
+            if a == 0 or b == 0 or (a > 0) != (b > 0):
+                raise ModelError(f"grid {path}={text}: log spacing needs START and STOP "
+                                 "non-zero and of one sign")
+            sign = 1.0 if a > 0 else -1.0
+            return (sign * np.geomspace(abs(a), abs(b), n)).tolist()
+        return np.linspace(a, b, n).tolist()
+    return [parse_set_value(text)]
+
+
+def parse_grid(items):
+    """``["PATH=VALUES", ...]`` -> ``{path: [values]}`` (see ``parse_range``)."""
+    grid = {}
+    for item in items:
+        if "=" not in item:
+            raise ModelError(f"grid {item!r}: expected PATH=VALUES, e.g. "
+                             "parameters.Mz=-0.03:-0.001:8")
+        path, text = item.split("=", 1)
+        path = path.strip()
+        if path in grid:
+            raise ModelError(f"grid {path}: given twice; give each path once")
+        grid[path] = parse_range(text, path)
+    return grid
+
+
+def expand(overrides=None, cases=None):
+    """The members: ``overrides`` is a grid ``{path: [values] or "START:STOP:N"}`` (every
+    combination, the last path varying fastest) or a list of ``{path: value}`` (one member
+    each); ``cases`` a list of case names (an outer loop), or None for the file's default.
+    Returns ``[{"case": ..., "overrides": [[path, value], ...]}]``."""
+    if overrides is None:
+        combos = [[]]
+    elif isinstance(overrides, dict):
+        axes = []
+        for path, values in overrides.items():
+            if isinstance(values, str):
+                values = parse_range(values, path)
+            elif not isinstance(values, (list, tuple, np.ndarray)):
+                values = [values]
+            values = [v.item() if isinstance(v, np.generic) else v for v in values]
+            if not values:
+                raise ModelError(f"grid {path}: no values; the sweep would have no members")
+            axes.append([(path, v) for v in values])
+        combos = [list(c) for c in itertools.product(*axes)]
+    else:
+        combos = [list(dict(m).items()) for m in overrides]
+    case_list = list(cases) if cases else [None]
+    members = [{"case": c, "overrides": [[p, v] for p, v in combo]}
+               for c in case_list for combo in combos]
+    if not members:
+        raise ModelError("the sweep has no members; give at least one override value")
+    return members
+
+
+# --------------------------------------------------------------------------- one member
+
+_TEXT_FILES = {}
+
+
+def _model_file(text, name):
+    """A file holding ``text`` in this process's temporary directory (one per text)."""
+    key = hashlib.sha256(text.encode()).hexdigest()[:16]
+    path = _TEXT_FILES.get(key)
+    if path is None or not os.path.exists(path):
+        folder = os.path.join(tempfile.gettempdir(), f"mbdyn-sweep-{os.getpid()}-{key}")
+        os.makedirs(folder, exist_ok=True)
+        path = os.path.join(folder, os.path.basename(name) or "model.toml")
+        with open(path, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        _TEXT_FILES[key] = path
+    return path
+
+
+def _triples(fixed, overrides):
+    """``(path, value, origin)`` for ``load_model``: the fixed ones, then the member's."""
+    return ([(p, v, f"fixed {p}={v!r}") for p, v in fixed]
+            + [(p, v, f"sweep {p}={v!r}") for p, v in overrides])
+
+
+def _load(task, member):
+    from ..io.loader import load_model
+    path = _model_file(task["model_text"], task["model_name"])
+    over = _triples(task["fixed"], member["overrides"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return load_model(path, case=member["case"], overrides=over)
+
+
+def _series(result, name):
+    if name in ("energy", "total_energy"):
+        return np.asarray(result.energy["total"]) if result.energy is not None else None
+    try:
+        return np.asarray(result[name], dtype=float)
+    except (KeyError, IndexError, ValueError, TypeError):
+        return None
+
+
+def columns(scene, quantities):
+    """The quantity columns of ``scene`` for ``quantities`` (errors name the bad one)."""
+    model = scene.model
+    names = list(model.coordinates) + list(model.speeds)
+    cols = []
+    for q in quantities:
+        if q == "final":
+            cols += [f"final.{n}" for n in names]
+        elif q == "events":
+            cols += [f"event.{e.name}" for e in scene.events]
+        elif q in SIMPLE:
+            cols.append(q)
+        elif ":" in q and q.split(":", 1)[0] in STATS:
+            stat, x = q.split(":", 1)
+            if x not in names + ["energy"]:
+                raise ModelError(f"quantity {q!r}: {x!r} is not a coordinate, a speed or "
+                                 f"energy; the names are: {', '.join(names)}, energy")
+            cols.append(f"{stat}.{x}")
+        else:
+            raise ModelError(f"unknown quantity {q!r}; use {', '.join(SIMPLE)} or "
+                             f"STAT:NAME with STAT one of {', '.join(STATS)}")
+    return cols
+
+
+def _needs_energy(quantities):
+    return any(q == "energy_drift" or q.endswith(":energy") for q in quantities)
+
+
+def measure(scene, result, quantities):
+    """``{column: float}`` of a (possibly partial) result."""
+    model = scene.model
+    out = {}
+    n = len(result.t)
+    for q in quantities:
+        if q == "final":
+            for name, v in zip(model.coordinates, result.q[-1] if n else [np.nan] * model.nq):
+                out[f"final.{name}"] = float(v)
+            for name, v in zip(model.speeds, result.u[-1] if n else [np.nan] * model.nu):
+                out[f"final.{name}"] = float(v)
+        elif q == "events":
+            for e in scene.events:
+                times = [t for name, t in result.events if name == e.name]
+                out[f"event.{e.name}"] = float(times[0]) if times else math.nan
+        elif q == "t_final":
+            out["t_final"] = float(result.t[-1]) if n else math.nan
+        elif q == "energy_drift":
+            s = _series(result, "energy")
+            out[q] = float(s[-1] - s[0]) if s is not None and len(s) else math.nan
+        elif q in ("steps", "rhs_evaluations"):
+            out[q] = float(result.stats.get(q, math.nan))
+        else:
+            stat, x = q.split(":", 1)
+            s = _series(result, x)
+            if s is None or not len(s):
+                out[f"{stat}.{x}"] = math.nan
+                continue
+            fn = {"max": np.max, "min": np.min, "mean": np.mean, "std": np.std,
+                  "absmax": lambda a: np.max(np.abs(a))}[stat]
+            out[f"{stat}.{x}"] = float(fn(s))
+    return out
+
+
+def run_member(task):
+    """Run one member (``task``: plain data, see ``Sweep.tasks``); returns its row
+    ``{"member": i, "status": "ok"|"failed"|"error", "error": text, column: value}``."""
+    member = task["member"]
+    row = {"member": member["index"], "status": "ok", "error": ""}
+    try:
+        scene = _load(task, member)
+    except ModelError as exc:
+        row.update(status="error", error=" ".join(str(exc).split()))
+        return row
+    qs = task["quantities"]
+    kw = {"outputs": ("energy",) if _needs_energy(qs) else (), "points": {}}
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            result = scene.simulate(**kw)
+    except SimulationError as exc:
+        row.update(status="failed", error=" ".join(str(exc).split()))
+        result = exc.result
+        if result is None:
+            return row
+        if _needs_energy(qs) and len(result.t):
+            try:
+                result.compute_outputs(("energy",), None, method="newton-euler")
+            except Exception:            # the failed state may not evaluate: keep NaN
+                pass
+    except ModelError as exc:
+        row.update(status="error", error=" ".join(str(exc).split()))
+        return row
+    row.update(measure(scene, result, qs))
+    return row
+
+
+# --------------------------------------------------------------------------- batched
+
+def batchable(scene, quantities):
+    """Why ``scene`` cannot run batched (a sentence), or None if it can: a fixed-step
+    integrator, the Jourdain method, no events, no Euler-angle joints (their singularity
+    is checked per step), no Python-function loads, quantities among final/t_final/
+    steps/rhs_evaluations."""
+    from ..simulate import FIXED_STEP
+    s = scene.settings
+    model = scene.model
+    if s["integrator"] not in FIXED_STEP:
+        return f"integrator {s['integrator']!r} is adaptive; batched runs are fixed-step"
+    if s["method"] != "jourdain":
+        return "batched runs use method 'jourdain'"
+    if scene.events:
+        return "the model has events (checked per step in Python)"
+    if model._euler_middle:
+        return "the model has Euler-angle joints (their singularity is checked per step)"
+    if model.has_callable_loads:
+        return "the model has Python-function loads"
+    bad = [q for q in quantities if q not in ("final", "t_final", "steps", "rhs_evaluations")]
+    if bad:
+        return f"quantities {bad} need the whole motion; batched runs keep the final state"
+    return None
+
+
+def run_batched(scenes, quantities):
+    """Rows of members that share one compiled model (their scenes differ only in the
+    initial state), advanced together by ``kernels.batched.batched_fixed_step``."""
+    from ..kernels.batched import batched_fixed_step
+    from ..kernels.integrators import SCHEMES, STAGES
+    scene = scenes[0]
+    model = scene.model
+    s = scene.settings
+    t0, t_end, dt = 0.0, float(s["t_end"]), float(s["dt"])
+    n_full = int(np.floor((t_end - t0) / dt * (1 + 1e-12)))       # as simulate plans it
+    times = t0 + dt * np.arange(1, n_full + 1)
+    if n_full and times[-1] > t_end:
+        times[-1] = t_end
+    t_last = times[-1] if n_full else t0
+    h_last = t_end - t_last if t_end - t_last > 1e-12 * max(1.0, abs(t_end)) else 0.0
+    starts = np.concatenate([[t0], times[:-1]])
+    stage = (starts[:, None] + dt * np.array(STAGES)[None, :]).reshape(-1)
+    table = model.drive_values(stage).reshape(n_full, len(STAGES), -1, 3)
+    last = model.drive_values(t_last + h_last * np.array(STAGES)).reshape(1, len(STAGES), -1, 3)
+    Y0 = np.array([np.concatenate([sc.q0, sc.u0]) for sc in scenes])
+    for y in Y0:
+        model.normalize_quaternions(y[:model.nq])
+    m = len(scenes)
+    Yend = np.empty_like(Y0)
+    done = np.zeros(m, np.int64)
+    status = np.zeros(m, np.int64)
+    nfev = np.zeros(m, np.int64)
+    batched_fixed_step(SCHEMES[s["integrator"]], dt, n_full, h_last, Y0, table, last,
+                       *model.loop_arguments(), Yend, done, status, nfev)
+    all_times = np.append(times, t_end) if h_last else times
+    rows = []
+    for i, sc in enumerate(scenes):
+        q = Yend[i, :model.nq].copy()
+        model.normalize_quaternions(q)
+        row = {"status": "ok", "error": ""}
+        if status[i]:
+            row.update(status="failed", error=f"loop status {int(status[i])} (NaN/Inf or a "
+                       f"singular mass matrix) after {int(done[i])} steps")
+        for qn in quantities:
+            if qn == "final":
+                row.update({f"final.{n}": float(v) for n, v in zip(model.coordinates, q)})
+                row.update({f"final.{n}": float(v)
+                            for n, v in zip(model.speeds, Yend[i, model.nq:])})
+            elif qn == "t_final":
+                row["t_final"] = float(all_times[done[i] - 1]) if done[i] else t0
+            elif qn == "steps":
+                row["steps"] = float(done[i])
+            elif qn == "rhs_evaluations":
+                row["rhs_evaluations"] = float(nfev[i])
+        rows.append(row)
+    return rows
+
+
+def run_batch_task(task):
+    """A worker's share of a batched sweep: ``task["members"]`` in one compiled call."""
+    scenes, rows = [], []
+    for member in task["members"]:
+        try:
+            scenes.append(_load(task, member))
+            rows.append(None)
+        except ModelError as exc:
+            rows.append({"status": "error", "error": " ".join(str(exc).split())})
+    ok = [i for i, r in enumerate(rows) if r is None]
+    # members that share one compiled model: group by everything but the initial state
+    groups = {}
+    for i in ok:
+        m = task["members"][i]
+        key = (m["case"], tuple((p, repr(v)) for p, v in m["overrides"]
+                                if not p.startswith(("initial.", "initial_speeds."))))
+        groups.setdefault(key, []).append(i)
+    for idx in groups.values():
+        for i, r in zip(idx, run_batched([scenes[ok.index(i)] for i in idx],
+                                          task["quantities"])):
+            rows[i] = r
+    for member, r in zip(task["members"], rows):
+        r["member"] = member["index"]
+    return rows
+
+
+# --------------------------------------------------------------------------- the table
+
+def _fmt(v):
+    if isinstance(v, float):
+        return repr(v)
+    return "" if v is None else str(v)
+
+
+class _Table:
+    """The CSV written row by row: a format line with the sweep's fingerprint, the
+    header, then one line per finished member (flushed and synced)."""
+
+    def __init__(self, path, header, spec):
+        self.path, self.header, self.spec = path, header, spec
+        self.fh = None
+
+    def read_done(self):
+        """Rows of a previous run of the same sweep (resume); [] if none."""
+        if not os.path.exists(self.path):
+            return []
+        with open(self.path, encoding="utf-8", newline="") as fh:
+            text = fh.read()
+        lines = text.split("\n")
+        if not lines or lines[0] != FORMAT_LINE + self.spec:
+            raise ModelError(f"{self.path}: not a table of this sweep (model, grid, cases or "
+                             "quantities differ); remove it or write elsewhere with --out")
+        complete = "\n".join(lines[1:-1])          # the last piece lacks its newline
+        rows = list(csv.reader(io.StringIO(complete)))
+        if not rows or rows[0] != self.header:
+            return []
+        return [dict(zip(self.header, r)) for r in rows[1:] if len(r) == len(self.header)]
+
+    def open(self, done_rows):
+        os.makedirs(os.path.dirname(os.path.abspath(self.path)), exist_ok=True)
+        self.fh = open(self.path, "w", encoding="utf-8", newline="")
+        self.fh.write(FORMAT_LINE + self.spec + "\n")
+        self.writer = csv.writer(self.fh, lineterminator="\n")
+        self.writer.writerow(self.header)
+        for r in done_rows:
+            self.writer.writerow([r.get(c, "") for c in self.header])
+        self._sync()
+
+    def write(self, row):
+        self.writer.writerow([_fmt(row.get(c, "")) for c in self.header])
+        self._sync()
+
+    def _sync(self):
+        self.fh.flush()
+        os.fsync(self.fh.fileno())
+
+    def finish(self, rows):
+        """Rewrite the file sorted by member (atomically)."""
+        self.fh.close()
+        folder = os.path.dirname(os.path.abspath(self.path))
+        fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
+            fh.write(FORMAT_LINE + self.spec + "\n")
+            w = csv.writer(fh, lineterminator="\n")
+            w.writerow(self.header)
+            for r in rows:
+                w.writerow([_fmt(r.get(c, "")) for c in self.header])
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, self.path)
+
+
+def read_table(path):
+    """A sweep CSV as ``{column: array}`` (numbers as floats, text as objects)."""
+    with open(path, encoding="utf-8", newline="") as fh:
+        first = fh.readline()
+        if not first.startswith(FORMAT_LINE):
+            fh.seek(0)
+        rows = list(csv.reader(fh))
+    header, body = rows[0], rows[1:]
+    return _as_arrays(header, [dict(zip(header, r)) for r in body])
+
+
+def _number(v):
+    if isinstance(v, (int, float)) and not isinstance(v, bool):
+        return float(v)
+    try:
+        return float(v) if v != "" else math.nan
+    except (TypeError, ValueError):
+        return None
+
+
+def _as_arrays(header, rows):
+    out = {}
+    for c in header:
+        vals = [r.get(c, "") for r in rows]
+        nums = [_number(v) for v in vals]
+        if c in ("status", "error", "case") or any(n is None for n in nums):
+            out[c] = np.array([_fmt(v) for v in vals], dtype=object)
+        elif c == "member":
+            out[c] = np.array(nums, dtype=np.int64)
+        else:
+            out[c] = np.array(nums, dtype=float)
+    return out
+
+
+# --------------------------------------------------------------------------- the sweep
+
+class SweepResult:
+    """The table of a finished sweep: ``columns``, ``rows`` (dicts in member order),
+    ``table()`` (a pandas DataFrame if pandas is installed, else ``{column: array}``),
+    ``arrays()`` (always ``{column: array}``), ``path`` (the CSV) and ``stats``."""
+
+    def __init__(self, header, rows, path, stats):
+        self.columns, self.rows, self.path, self.stats = header, rows, path, stats
+
+    def arrays(self):
+        return _as_arrays(self.columns, self.rows)
+
+    def table(self):
+        arrays = self.arrays()
+        try:
+            import pandas as pd
+        except ImportError:
+            return arrays
+        return pd.DataFrame(arrays, columns=self.columns)
+
+    def __len__(self):
+        return len(self.rows)
+
+    def __repr__(self):
+        bad = sum(r.get("status") != "ok" for r in self.rows)
+        return f"<SweepResult {len(self.rows)} members ({bad} not ok), {self.columns}>"
+
+
+def _progress(total, enabled):
+    if not enabled:
+        return None
+    try:
+        from tqdm import tqdm
+        return tqdm(total=total, file=sys.stderr, unit="member", leave=False)
+    except ImportError:
+        class Bar:
+            def __init__(self):
+                self.n = 0
+
+            def update(self, k):
+                self.n += k
+                sys.stderr.write(f"\rmbdyn sweep: {self.n}/{total} members")
+                sys.stderr.flush()
+
+            def close(self):
+                sys.stderr.write("\n")
+        return Bar()
+
+
+def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, fixed=None,
+          scheduler="serial", workers=None, out=None, resume=False, batched=False,
+          batch_size=None, progress=None):
+    """Run the model file ``model`` (a path or a ``Scene`` loaded from one) over
+    ``overrides`` and return a ``SweepResult``.
+
+    ``overrides``: a grid ``{path: values}`` (values a list, or a range text
+    ``"START:STOP:N"``/``"START:STOP:N:log"``) or a list of ``{path: value}`` members.
+    ``cases``: case names to sweep too (default: the scene's case or the file's default).
+    ``fixed``: ``{path: value}`` applied to every member first (e.g. ``simulation.dt``).
+    ``quantities``: see the module docstring.  ``scheduler``: ``"serial"``,
+    ``"processes"``, ``"dask"``, ``"tcp://HOST:PORT"`` or a scheduler object
+    (``schedulers``); ``workers``: local worker count.  ``out``: the CSV to write as
+    members finish (``.parquet`` too if the name ends so and pyarrow is present);
+    ``resume``: keep the finished rows of ``out`` and run only the rest.
+    ``batched``: advance members that share one compiled model in one compiled call
+    (fixed-step schemes only; see ``batchable``), ``batch_size`` members per task.
+    ``progress``: show a bar on stderr (default: when stderr is a terminal).
+
+    Everything that can be checked is checked before any member runs: the paths, the
+    range texts, the quantities, an empty sweep.
+    """
+    from ..io.loader import load_model
+    path = getattr(model, "path", model)
+    if cases is None and getattr(model, "case", None) is not None and not isinstance(model, str):
+        cases = [model.case]
+    with open(path, encoding="utf-8") as fh:
+        text = fh.read()
+    members = expand(overrides, cases)
+    if out is not None and str(out).endswith(".parquet"):
+        try:
+            import pyarrow  # noqa: F401
+        except ImportError:
+            raise ModelError(f"{out}: writing Parquet needs pyarrow (pip install pyarrow); "
+                             "or write a .csv") from None
+    fixed_list = [[p, v] for p, v in (fixed or {}).items()]
+    quantities = tuple(quantities)
+    # check before any work: load the first and the last member (every path appears in
+    # both; a value that only fails in the middle becomes that member's error)
+    header = None
+    for member in (members[0], members[-1]):
+        over = _triples(fixed_list, member["overrides"])
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            scene = load_model(path, case=member["case"], overrides=over)
+        header = header or columns(scene, quantities)
+    if batched:
+        why = batchable(scene, quantities)
+        if why:
+            raise ModelError(f"cannot run batched: {why}; run without batching")
+    paths = [p for p, _ in members[0]["overrides"]]
+    with_case = cases is not None and len(members) > 0 and len(set(m["case"] for m in members)) > 1
+    head = ["member"] + (["case"] if with_case else []) + paths + ["status", "error"] + header
+    for i, m in enumerate(members):
+        m["index"] = i
+    spec = hashlib.sha256(json.dumps([text, members, fixed_list, list(quantities)],
+                                     default=repr).encode()).hexdigest()[:20]
+    rows = {}
+    table = None
+    if out is not None:
+        csv_path = out if not str(out).endswith(".parquet") else str(out)[:-8] + ".csv"
+        table = _Table(str(csv_path), head, spec)
+        done = table.read_done() if resume else []
+        for r in done:
+            rows[int(r["member"])] = r
+        table.open(done)
+    todo = [m for m in members if m["index"] not in rows]
+    base = {"model_text": text, "model_name": os.path.basename(str(path)), "fixed": fixed_list,
+            "quantities": list(quantities)}
+
+    def label(row):
+        m = members[row["member"]]
+        row.update({p: v for p, v in m["overrides"]})
+        if with_case:
+            row["case"] = m["case"]
+        return row
+
+    show = progress if progress is not None else bool(getattr(sys.stderr, "isatty",
+                                                              lambda: False)())
+    bar = _progress(len(members), show and bool(todo))
+    if bar is not None and rows:
+        bar.update(len(rows))
+    sched = make_scheduler(scheduler, workers)
+    start = time.perf_counter()
+    try:
+        if batched:
+            size = batch_size or max(1, math.ceil(len(todo) / max(1, getattr(
+                sched, "workers", 1) if sched.name != "serial" else 1)))
+            tasks = [dict(base, members=todo[k:k + size]) for k in range(0, len(todo), size)]
+            stream = ((i, r) for i, rs in sched.map_unordered(run_batch_task, tasks)
+                      for r in rs)
+        else:
+            tasks = [dict(base, member=m) for m in todo]
+            stream = sched.map_unordered(run_member, tasks)
+        for _, row in stream:
+            row = label(row)
+            rows[row["member"]] = row
+            if table is not None:
+                table.write(row)
+            if bar is not None:
+                bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
+        sched.close()
+    wall = time.perf_counter() - start
+    ordered = [rows[i] for i in range(len(members))]
+    # rows read back from a file hold text: make them the same values as fresh rows
+    ordered = [{c: _typed(r.get(c, ""), c) for c in head} for r in ordered]
+    if table is not None:
+        table.finish(ordered)
+        if str(out).endswith(".parquet"):
+            write_parquet(str(out), head, ordered)
+    stats = {"members": len(members), "ran": len(todo), "wall_time_s": wall,
+             "scheduler": getattr(sched, "name", str(scheduler)), "batched": bool(batched)}
+    return SweepResult(head, ordered, table.path if table else None, stats)
+
+
+def _typed(v, column):
+    if column in ("status", "error", "case"):
+        return "" if v is None else str(v)
+    if column == "member":
+        return int(v)
+    if isinstance(v, str):
+        n = _number(v)
+        return v if n is None else n
+    if isinstance(v, (int, float)) and not isinstance(v, bool):
+        return float(v)
+    return v
+
+
+def write_parquet(path, header, rows):
+    """The table as Parquet (needs pyarrow)."""
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+    except ImportError:
+        raise ModelError(f"{path}: writing Parquet needs pyarrow (pip install pyarrow); "
+                         "the CSV beside it holds the same table") from None
+    arrays = _as_arrays(header, rows)
+    pq.write_table(pa.table({c: list(arrays[c]) for c in header}), path)

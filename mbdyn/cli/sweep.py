@@ -1,0 +1,110 @@
+"""``mbdyn sweep MODEL``: run a model file over a grid of overrides; a table of results.
+
+The work is ``mbdyn.analysis.sweep``; this module only reads the command line."""
+from __future__ import annotations
+
+import json
+import math
+import sys
+
+from ..analysis.sweep import DEFAULT_QUANTITIES, parse_grid, sweep
+from ..errors import ModelError
+from .common import fmt
+from ..io.schema import parse_set_value
+
+
+def register(subparsers):
+    p = subparsers.add_parser(
+        "sweep", help="run a model file over a grid of overrides (parameters, initial "
+                      "state, settings); one table row per member",
+        description="Run MODEL once per member of a grid of overrides by dotted path and "
+                    "keep quantities of each run in a table (CSV).  Ranges: START:STOP:N "
+                    "(N points, ends included), START:STOP:N:log, or a list [a, b, \"pi/4\"].")
+    p.add_argument("model", metavar="MODEL", help="model file (.toml)")
+    p.add_argument("--grid", metavar="PATH=VALUES", action="append", default=[],
+                   help="one axis of the grid, e.g. parameters.Mz=-0.03:-0.001:8 or "
+                        "initial.theta=[0.1, 0.2] (repeatable: every combination)")
+    p.add_argument("--case", metavar="NAME", action="append",
+                   help="case(s) to run (repeatable: an outer loop); default the file's")
+    p.add_argument("--set", dest="fixed", metavar="PATH=VALUE", action="append", default=[],
+                   help="override for every member, e.g. simulation.integrator=rk4")
+    p.add_argument("--quantity", "-q", dest="quantities", metavar="Q", action="append",
+                   help="what to keep per member: final, events, t_final, energy_drift, "
+                        "steps, rhs_evaluations, max:X, min:X, absmax:X, mean:X, std:X "
+                        f"(default: {', '.join(DEFAULT_QUANTITIES)})")
+    p.add_argument("--scheduler", default="serial", metavar="WHERE",
+                   help="serial (default), processes, dask (a local Dask cluster) or "
+                        "tcp://HOST:PORT (an existing Dask scheduler)")
+    p.add_argument("--workers", type=int, metavar="N", help="local worker processes")
+    p.add_argument("--batched", action="store_true",
+                   help="advance members in one compiled call (fixed-step, no events)")
+    p.add_argument("--out", metavar="FILE", help="the table (.csv, or .parquet with pyarrow); "
+                                                 "rows are written as members finish")
+    p.add_argument("--resume", action="store_true",
+                   help="keep the finished rows of --out and run only the rest")
+    p.add_argument("--plot", metavar="QUANTITY",
+                   help="a line (one grid axis) or heat map (two) of a table column; "
+                        "written beside --out as .png (or to --plot-file)")
+    p.add_argument("--plot-file", metavar="PNG", help="where --plot writes")
+    p.add_argument("--json", action="store_true",
+                   help="print the table as one JSON object {column: [values]} and nothing "
+                        "else on stdout (no progress bar)")
+    p.set_defaults(func=run)
+
+
+def _fixed(items):
+    out = {}
+    for item in items:
+        if "=" not in item:
+            raise ModelError(f"--set {item}: expected PATH=VALUE, e.g. simulation.dt=1e-3")
+        path, value = item.split("=", 1)
+        out[path.strip()] = parse_set_value(value)
+    return out
+
+
+def _json_value(v):
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
+    return v
+
+
+def run(args):
+    if args.resume and not args.out:
+        raise ModelError("--resume needs --out FILE (the table to complete)")
+    if not args.grid:
+        raise ModelError("give at least one --grid PATH=VALUES (e.g. "
+                         "--grid parameters.Mz=-0.03:-0.001:8)")
+    grid = parse_grid(args.grid)
+    plot_file = args.plot_file or (args.out.rsplit(".", 1)[0] + f"_{args.plot}.png"
+                                   if args.plot and args.out else None)
+    if args.plot and not plot_file:
+        raise ModelError("--plot needs --out FILE or --plot-file PNG")
+    result = sweep(args.model, grid, tuple(args.quantities or DEFAULT_QUANTITIES),
+                   cases=args.case, fixed=_fixed(args.fixed), scheduler=args.scheduler,
+                   workers=args.workers, out=args.out, resume=args.resume,
+                   batched=args.batched, progress=False if args.json else None)
+    if args.plot:
+        from ..viz.sweep_plots import plot_sweep
+        plot_sweep(result, args.plot, plot_file, axes=list(grid))
+    if args.json:
+        table = {c: [_json_value(r[c]) for r in result.rows] for c in result.columns}
+        sys.stdout.write(json.dumps(table) + "\n")
+        return 0
+    bad = [r for r in result.rows if r["status"] != "ok"]
+    st = result.stats
+    sys.stdout.write(f"{len(result.rows)} members ({st['ran']} run now, {len(bad)} not ok) "
+                     f"on {st['scheduler']}{' batched' if st['batched'] else ''} in "
+                     f"{fmt(st['wall_time_s'])} s\n")
+    for r in bad[:10]:
+        sys.stdout.write(f"  member {r['member']}: {r['status']}: {r['error']}\n")
+    if args.out:
+        sys.stdout.write(f"  wrote {result.path}\n")
+    if args.plot:
+        sys.stdout.write(f"  wrote {plot_file}\n")
+    if not args.out and not args.plot:
+        cols = result.columns
+        sys.stdout.write(",".join(cols) + "\n")
+        for r in result.rows:
+            sys.stdout.write(",".join(fmt(r[c]) if isinstance(r[c], float) else str(r[c])
+                                      for c in cols) + "\n")
+    return 0
