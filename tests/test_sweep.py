@@ -218,3 +218,20 @@ def test_kill_and_resume_gives_the_uninterrupted_table(tmp_path):
     assert part.read_text() == full.read_text()
     t = read_table(str(full))
     assert list(t["member"]) == list(range(6)) and set(t["status"]) == {"ok"}
+
+
+def test_cli_json_and_plot(tmp_path, capsys):
+    import json
+    from mbdyn.cli import main
+    args = ["sweep", PENDULUM, "--grid", "initial.theta1=0.1:0.3:2", "--grid",
+            "initial.theta2=[0.0, 0.2]", "--set", "simulation.t_end=0.05", "-q", "final"]
+    assert main(args + ["--json"]) == 0
+    out, err = capsys.readouterr()
+    table = json.loads(out)
+    assert table["member"] == [0, 1, 2, 3] and table["initial.theta2"] == [0.0, 0.2, 0.0, 0.2]
+    assert err == ""
+    png = tmp_path / "t_final.theta1.png"
+    assert main(args + ["--out", str(tmp_path / "t.csv"), "--plot", "final.theta1"]) == 0
+    assert png.exists() and png.stat().st_size > 1000
+    assert main(args + ["--plot", "nope", "--plot-file", str(png)]) == 1
+    assert "not a column" in capsys.readouterr().err
