@@ -16,8 +16,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import ModelError, NonFiniteError, SingularMassMatrixError
+from .force_packing import pack_forces
 from .kernels import dynamics as kd
 from .kernels import evaluate as ke
+from .kernels import forces as kf
 from .kernels import joints as kj
 from .kernels import packed as kp
 from .kernels.kinematics import point_jacobian
@@ -105,7 +107,7 @@ class Model:
     """
 
     def __init__(self, name, bodies, joints, loads, gravity, warnings=(), parameters=None,
-                 gravity_symbolic=None):
+                 gravity_symbolic=None, forces=(), effects=None):
         self.name = name
         self.warnings = tuple(warnings)
         self.gravity = np.array(gravity, dtype=float)
@@ -214,6 +216,15 @@ class Model:
                     load_functions.append((ld.name, target, k, val))
                 else:
                     getattr(self, target)[k] = val
+        # -- force elements and the effects the scene chose (only what is on is here)
+        self._force_elements = tuple(forces)
+        self.forces = tuple(el.name for el in forces)
+        #: ``{effect: on}`` as the scene chose them (see ``mbdyn.effects``)
+        self.effects = dict(effects) if effects is not None else dict.fromkeys(
+            ("gravity", "gyroscopic") + self.loads + self.forces, True)
+        self.gyroscopic = bool(self.effects.get("gyroscopic", True))
+        self._force_int, self._force_data = pack_forces(self, forces)
+        self._switches = np.array([1 if self.gyroscopic else 0], np.int64)
         # -- workspace
         self._qfull = np.zeros(nqf)
         self._ufull = np.zeros(nuf)
@@ -245,7 +256,8 @@ class Model:
         self._tree = (self._parent, self._kind, self._axis, self._seq, self._pos, self._C,
                       self._qoff, self._uoff, self._ucol, self._anc_ptr, self._anc_idx)
         self._loads_arrays = (self._load_body, self._load_point, self._load_force,
-                              self._load_moment, self._load_in_body)
+                              self._load_moment, self._load_in_body, self._force_int,
+                              self._force_data, self._switches)
         self._kin_out = (self._R, self._r, self._w, self._v, self._alpha, self._a,
                          self._JR, self._JT, self._F, self._N)
 
@@ -433,8 +445,15 @@ class Model:
                                 *self._kin_out)
         return q, u
 
+    def _drop_velocity_products(self):
+        """With the gyroscopic effect off: bias accelerations without velocity products."""
+        if not self.gyroscopic:
+            ke.drop_velocity_products(*self._tree, self._qfull, self._ufull, self._udfull,
+                                      *self._kin_out[:8])
+
     def _jourdain_terms(self, q, u, t):
         q, u = self._kinematics_kernel(q, u, t)
+        self._drop_velocity_products()
         kd.jourdain(self._mass, self._com, self._inertia, self._has_inertia, self._R, self._r,
                     self._w, self._alpha, self._a, self._JR, self._JT, self._anc_ptr,
                     self._anc_idx, self._parent, self._F, self._N, self._M, self._f)
@@ -592,6 +611,7 @@ class Model:
         elif method == "jourdain":
             ud = self.forward_dynamics(q, u, t)
             self._kinematics_kernel(q, u, t, ud)
+            self._drop_velocity_products()
             w = np.empty((self.n_frames, 6))
             kd.joint_wrenches(self._mass, self._com, self._inertia, self._parent, self._R,
                               self._r, self._w, self._alpha, self._a, self._F, self._N, w)
@@ -632,6 +652,43 @@ class Model:
         T, V = kd.energies(self._mass, self._com, self._inertia, self.gravity, self._R,
                            self._r, self._w, self._v)
         return float(T), float(V)
+
+    def element_energy(self, q, u, t=0.0):
+        """Force elements' ``(potential energy, non-conservative power)``: the energy stored
+        in springs and contacts, and the power dampers, friction, bushings and bearings
+        deliver to the system (negative when they take energy out)."""
+        if not self.forces:
+            return 0.0, 0.0
+        self._kinematics_kernel(q, u, t)
+        acc = np.zeros(2)
+        kf.force_elements(self._force_int, self._force_data, self._parent, self._axis,
+                          self._com, self._qfull, self._ufull, self._R, self._r, self._w,
+                          self._v, self._F, self._N, acc)
+        return float(acc[0]), float(acc[1])
+
+    def load_power(self, q, u, t=0.0):
+        """Power of the loads (``add_load``) on the system: force times the velocity of its
+        point plus moment times the body's angular velocity."""
+        if not self.loads:
+            return 0.0
+        self._kinematics_kernel(q, u, t)
+        P = 0.0
+        for k in range(len(self.loads)):
+            i = self._load_body[k]
+            f, m = self._load_force[k], self._load_moment[k]
+            if self._load_in_body[k]:
+                f, m = self._R[i] @ f, self._R[i] @ m
+            lever = self._R[i] @ self._load_point[k]
+            P += f @ (self._v[i] + np.cross(self._w[i], lever)) + m @ self._w[i]
+        return float(P)
+
+    def force_element(self, name):
+        """The force-element record (kind, frames, parameters) by name."""
+        for el in self._force_elements:
+            if el.name == name:
+                return el
+        raise ModelError(f"unknown force element {name!r}; the model's force elements are "
+                         f"{', '.join(self.forces) or '(none)'}")
 
     def point_positions(self, q, points, t=0.0):
         """World positions of points fixed on frames: ``points`` is a list of

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import integrate, optimize
 
+from .balance import energy_balance
 from .errors import (ModelError, NonFiniteError, SimulationError, SingularityWarning,
                      SingularMassMatrixError)
 
@@ -52,9 +53,11 @@ class Result:
     ``t`` (n,), ``q`` (n, nq), ``u`` (n, nu); ``res["theta1"]`` gives a coordinate or speed
     by name; ``events`` is ``[(name, t), ...]``; ``stats`` the integrator's statistics;
     on request ``reactions`` ``{joint: (n, 6)}`` (force then moment, world components, at
-    the joint origin), ``energy`` ``{"kinetic", "potential", "total"}`` and ``points``
+    the joint origin), ``energy`` (see ``mbdyn.balance.energy_balance``: ``kinetic``,
+    ``potential``, ``total`` = T + V, ``dissipated``, ``work``, ``balance``) and ``points``
     ``{name: (n, 3)}``.  With energies, ``stats["energy_drift"]`` is
-    ``max |E(t) - E(0)|`` over the energy scale ``max(|E(0)|, max T, max |V|)``.
+    ``max |B(t) - B(0)|`` of the balance ``B = T + V + dissipated - work`` over the energy
+    scale (the largest of its terms).
     """
 
     def __init__(self, model, t, q, u, events, stats):
@@ -114,12 +117,13 @@ class Result:
             self.reactions = reac
             self.drive_efforts = efforts
         if "energy" in outputs:
-            TV = np.array([model.energy(self.q[k], self.u[k], self.t[k]) for k in range(n)])
-            self.energy = {"kinetic": TV[:, 0], "potential": TV[:, 1],
-                           "total": TV[:, 0] + TV[:, 1]}
-            E0 = self.energy["total"][0]
-            scale = max(abs(E0), np.abs(TV).max(), 1e-300)
-            self.stats["energy_drift"] = float(np.abs(self.energy["total"] - E0).max() / scale)
+            self.energy = energy_balance(model, self.t, self.q, self.u)
+            E = self.energy["balance"]
+            scale = max(abs(E[0]), np.abs(self.energy["kinetic"]).max(),
+                        np.abs(self.energy["potential"]).max(),
+                        np.abs(self.energy["dissipated"]).max(),
+                        np.abs(self.energy["work"]).max(), 1e-300)
+            self.stats["energy_drift"] = float(np.abs(E - E[0]).max() / scale)
         if points:
             names = list(points)
             specs = [points[p] for p in names]
