@@ -4,7 +4,7 @@ Assemble bodies, frames and joints into a tree (``System``), compile it to a ``M
 evaluate kinematics, Jacobians, the Newton-Euler-Jourdain form ``M(q) u' = f`` or the
 Newton-Euler system with reactions, and integrate with ``simulate``.
 """
-from . import inertia
+from . import effects, forces, inertia
 from .compile import Kinematics, Model
 from .elements import t
 from .errors import (ModelError, ModelWarning, NonFiniteError, SimulationError,
@@ -19,4 +19,5 @@ __version__ = "0.1.0"
 __all__ = ["System", "Model", "Kinematics", "Result", "Event", "simulate", "inertia", "t",
            "GROUND", "INTEGRATORS", "FIXED_STEP", "ModelError", "ModelWarning",
            "NonFiniteError", "SimulationError", "SingularityWarning",
-           "SingularMassMatrixError", "load_model", "Scene", "ModelFileError", "derive"]
+           "SingularMassMatrixError", "load_model", "Scene", "ModelFileError", "derive",
+           "forces", "effects"]

@@ -121,11 +121,29 @@ def pack_forces(model, forces):
     return force_int, force_data
 
 
-def bearing_ranges(forces):
-    """``{element: (speed name, low, high)}`` of the bearings with tabulated coefficients."""
-    out = {}
-    for el in forces:
-        if el.kind == "bearing" and el.params["speeds"] is not None:
-            s = el.params["speeds"]
-            out[el.name] = (el.params["speed"], float(s[0]), float(s[-1]))
-    return out
+def warn_outside_tables(model, t, u):
+    """Warn when a bearing's spin speed left the range of its coefficient table along a
+    motion (times ``t``, free speeds ``u`` row by row): the coefficients are held at the
+    table's end values there, which is a guess."""
+    import warnings
+    from .errors import ModelWarning
+    for el in model._force_elements:
+        if el.kind != "bearing" or el.params["speeds"] is None or not len(t):
+            continue
+        name = el.params["speed"]
+        if name in model.speeds:
+            spin = np.asarray(u)[:, model.speed_index(name)]
+        else:
+            drive = next((d for jn, _, _, d in model._driven
+                          if jn == name or name in model._joint[jn].coordinates), None)
+            if drive is None:
+                continue
+            spin = np.array([drive.velocity(tk) for tk in t])
+        lo, hi = float(el.params["speeds"][0]), float(el.params["speeds"][-1])
+        out = (spin < lo - 1e-12 * abs(lo)) | (spin > hi + 1e-12 * abs(hi))
+        if np.any(out):
+            k = int(np.argmax(out))
+            warnings.warn(f"force {el.name!r}: the spin speed {name} = {spin[k]:.6g} at "
+                          f"t = {t[k]:.6g} is outside its coefficient table ({lo:g} .. {hi:g}); "
+                          "the coefficients are held at the table's end values there -- "
+                          "extend the table to cover the motion", ModelWarning, stacklevel=3)

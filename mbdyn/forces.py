@@ -166,6 +166,16 @@ class ForceElement:
                 f"e = {p['restitution']:g}, mu = {p['friction']:g}")
 
 
+def radial_directions(axis):
+    """The bearing's x and y directions across a shaft ``axis``: ``e1 x e2 = axis``, and
+    for a coordinate axis the next two in cyclic order (axis x: y, z; axis z: x, y)."""
+    i = int(np.argmax(np.abs(axis)))
+    helper = np.eye(3)[(i + 1) % 3]
+    e1 = helper - (helper @ axis) * axis
+    e1 /= np.linalg.norm(e1)
+    return e1, np.cross(axis, e1)
+
+
 def _number(value, parameters, element, what, minimum=None, positive=False):
     v = numeric(value, parameters, element, what)
     try:
@@ -334,9 +344,7 @@ def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):
                 raise ModelError(f"{element}: {c} must be >= 0 (a negative direct damping "
                                  "feeds energy in)")
         axis = parse_axis(kw.get("axis", "x"), element)
-        e1 = np.cross(axis, np.eye(3)[np.argmin(np.abs(axis))])
-        e1 /= np.linalg.norm(e1)
-        e2 = np.cross(axis, e1)
+        e1, e2 = radial_directions(axis)
         params = dict(coeffs)
         params.update({
             "point": _vector3(numeric(kw.get("point", (0, 0, 0)), parameters, element,

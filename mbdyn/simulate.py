@@ -17,6 +17,7 @@ import numpy as np
 from scipy import integrate, optimize
 
 from .balance import energy_balance
+from .force_packing import warn_outside_tables
 from .errors import (ModelError, NonFiniteError, SimulationError, SingularityWarning,
                      SingularMassMatrixError)
 
@@ -329,6 +330,8 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator="RK45", rtol=
     for row in qs:                      # report unit quaternions; the drift is in stats
         model.normalize_quaternions(row)
     result = Result(model, ts, qs, ys[:, model.nq:], found, stats)
+    if getattr(model, "_force_elements", ()):
+        warn_outside_tables(model, ts, ys[:, model.nq:])
     if failure is not None:
         stats["status"] = "failed"
         result.stats = stats
