@@ -395,3 +395,46 @@ def test_malformed_force_elements_in_a_file_name_the_key(tmp_path):
                                  '[0.05, 100]]'))
     with pytest.raises(mb.ModelFileError, match="not monotone"):
         mb.load_model(path)
+
+
+# ----------------------------------------------------------------------------- symbolic
+def sprung_double_pendulum():
+    s = mb.System("sprung double pendulum", gravity=(0, -9.81, 0),
+                  parameters={"k": 50.0, "c": 0.3})
+    k, c = s.symbols("k c")
+    s.add_body("m1", mass=0.5, com=(0, -0.3, 0))
+    s.add_joint("th1", "revolute", parent="ground", child="m1", axis="z")
+    s.add_body("m2", mass=0.4, com=(0, -0.3, 0), inertia=[0.01, 0.01, 0.02])
+    s.add_joint("th2", "revolute", parent="m1", child="m2", axis="z", position=(0, -0.3, 0))
+    s.add_force("spring", "spring-damper", body_a="ground", point_a=(0.3, 0.1, 0),
+                body_b="m2", point_b=(0.05, -0.3, 0), stiffness=k, damping=c,
+                free_length=0.2, preload=1.0)
+    s.add_force("torsion", "joint-spring-damper", joint="th2", stiffness=2 * k, damping=c,
+                rest=0.3)
+    return s
+
+
+@pytest.mark.parametrize("method", ["jourdain", "newton-euler", "lagrange"])
+def test_symbolic_springs_and_dampers_agree_with_the_engine(method):
+    from mbdyn.symbolic.compare import compare_numerically
+    model = sprung_double_pendulum().compile()
+    d = mb.derive(model, method=method, solve=method == "newton-euler")
+    what = ("accelerations", "reactions") if method == "newton-euler" else ("mass_matrix",
+                                                                             "forcing")
+    for name, err in compare_numerically(d, what=what).items():
+        assert err < 1e-12, (method, name, err)
+    assert "k" in {s.name for s in d.forcing.free_symbols}     # parameters stay symbols
+
+
+def test_eom_with_an_effect_off_equals_the_element_deleted():
+    off = mb.derive(sprung_double_pendulum().compile(effects="-spring"))
+    s = sprung_double_pendulum()
+    del s._forces["spring"]
+    gone = mb.derive(s.compile())
+    assert off.forcing == gone.forcing and off.mass_matrix == gone.mass_matrix
+
+
+def test_symbolic_layer_refuses_what_it_cannot_write_and_names_the_remedy():
+    model = every_kind_system().compile()
+    with pytest.raises(ModelError, match=r"--effects=-progressive"):
+        mb.derive(model)

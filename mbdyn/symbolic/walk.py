@@ -205,6 +205,7 @@ class Walk:
             if joint.parent in self.by_name:
                 self.by_name[joint.parent].children.append(m)
         self._apply_loads()
+        self._apply_forces()
 
     # ------------------------------------------------------------------ helpers
     def s(self, expr):
@@ -396,6 +397,76 @@ class Walk:
             m.loads.append((load.name, F, N, point))
             m.force = self.s(m.force + F)
             m.moment = self.s(m.moment + N + cross(lever, F))
+
+    # ------------------------------------------------------------------ force elements
+    def _param(self, el, key):
+        value = el.symbolic.get(key, el.params[key])
+        if isinstance(value, sympy.Basic):
+            return canonical(value, self.sym.table)
+        return exact(value)
+
+    def _world_point(self, frame, point):
+        """World position of a point fixed on ``frame`` (own components)."""
+        if frame == "ground":
+            return point
+        m = self.by_name[frame]
+        if self.frames == "own":
+            return self.s(self.absolute_T(frame).T * (m.r + point))
+        return self.s(m.r + m.X_child * point)
+
+    def _add_wrench(self, name, frame, F_world, N_world, point):
+        """Element ``name``'s force (world components) at ``point`` (own components) and
+        moment on ``frame``, into its applied loads."""
+        if frame == "ground":
+            return
+        m = self.by_name[frame]
+        F = self.to_basis(m, F_world, False)
+        N = self.to_basis(m, N_world, False)
+        m.loads.append((name, F, N, point))
+        lever = point - m.com if m.X_child is E3 else m.X_child * (point - m.com)
+        m.force = self.s(m.force + F)
+        m.moment = self.s(m.moment + N + cross(lever, F))
+
+    def _apply_forces(self):
+        """Springs and dampers in closed form: a spring-damper's tension along the line of
+        its points, a joint spring-damper's effort on its coordinate."""
+        for el in getattr(self.model, "_force_elements", ()):
+            p = el.params
+            tabulated = [k for k in ("force_table", "damping_table") if p.get(k) is not None]
+            if el.kind not in ("spring-damper", "joint-spring-damper") or tabulated:
+                what = "tabulated laws" if tabulated else f"{el.kind} elements"
+                raise ModelError(f"force {el.name!r}: the symbolic layer writes linear springs "
+                                 f"and dampers in closed form, not {what}; switch it off to "
+                                 f"derive the rest (--effects=-{el.name})")
+            k, c, F0 = (self._param(el, key) for key in ("stiffness", "damping", "preload"))
+            if el.kind == "spring-damper":
+                pa = exact_vector(el.symbolic.get("point_a", p["point_a"]), self.sym.table)
+                pb = exact_vector(el.symbolic.get("point_b", p["point_b"]), self.sym.table)
+                a, b = el.frames
+                d = self._world_point(b, pb) - self._world_point(a, pa)
+                L = sympy.sqrt((d.T * d)[0])
+                T = F0 + k * (L - self._param(el, "free_length")) + c * self.D(L)
+                f = d * (T / L)
+                self._add_wrench(el.name, a, f, Z3, pa)
+                self._add_wrench(el.name, b, -f, Z3, pb)
+            else:
+                joint = next(j for j in self.joints if j.name == p["joint"])
+                qj, uj, _, driven = self.joint_values[joint.name]
+                x = qj[0] - self._param(el, "rest")
+                tau = -(F0 + k * x + c * uj[0])
+                m = self.by_name[joint.child]
+                axis = self._joint_geometry(joint)[0]
+                # the axis in world components: joint frame J0 = child axes along the axis
+                axis_w = (self.absolute_T(joint.child).T * axis if self.frames == "own"
+                          else m.X_child * axis)
+                axis_w = self.s(axis_w)
+                if joint.kind == "revolute":
+                    self._add_wrench(el.name, joint.child, Z3, tau * axis_w, m.com * 0)
+                    self._add_wrench(el.name, joint.parent, Z3, -tau * axis_w, m.com * 0)
+                else:
+                    self._add_wrench(el.name, joint.child, tau * axis_w, Z3, m.com * 0)
+                    if joint.parent != "ground":
+                        self._add_wrench(el.name, joint.parent, -tau * axis_w, Z3, m.rho_p)
 
     # ------------------------------------------------------------------ for the methods
     def point_jacobians(self, m, point):
