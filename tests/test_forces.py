@@ -438,3 +438,39 @@ def test_symbolic_layer_refuses_what_it_cannot_write_and_names_the_remedy():
     model = every_kind_system().compile()
     with pytest.raises(ModelError, match=r"--effects=-progressive"):
         mb.derive(model)
+
+
+# ----------------------------------------------------------------------------- models
+def test_top_on_the_floor_follows_the_fixed_point_top_then_lands_on_its_rim():
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", mb.ModelWarning)
+        floor = mb.load_model(MODELS / "top.toml", case="floor").simulate(t_end=1.0)
+        ref = mb.load_model(MODELS / "top.toml", case="a").simulate(
+            integrator="DOP853", rtol=1e-10, atol=1e-12, t_end=1.0)
+    theta = np.arccos(np.clip(1 - 2 * (floor["qx"] ** 2 + floor["qy"] ** 2), -1, 1))
+    assert np.abs(theta - np.interp(floor.t, ref.t, ref["theta"])).max() < 0.02
+    assert floor.stats["energy_drift"] < 1e-5
+    assert np.abs(floor["z"]).max() < 1e-3           # the tip stays on the floor
+
+
+def test_quarter_car_steady_response_matches_the_transfer_function():
+    scene = mb.load_model(MODELS / "quarter_car.toml")
+    p = scene.parameters
+    res = scene.simulate(rtol=1e-11, atol=1e-13)
+    w = 2 * np.pi * p["f"]
+    M = np.diag([p["mb"], p["mw"]])
+    C = np.array([[p["cs"], -p["cs"]], [-p["cs"], p["cs"]]])
+    K = np.array([[p["ks"], -p["ks"]], [-p["ks"], p["ks"] + p["kt"]]])
+    Z = np.linalg.solve(-w ** 2 * M + 1j * w * C + K, [0.0, p["kt"] * p["A"]])
+    late = res.t > 8.0
+    basis = np.column_stack([np.sin(w * res.t[late]), np.cos(w * res.t[late])])
+    for name, z in (("zb", Z[0]), ("zw", Z[1])):
+        (a, b), *_ = np.linalg.lstsq(basis, res[name][late], rcond=None)
+        # A sin(wt) drives: the response is Im(Z e^{iwt}) = Re(Z) sin + Im(Z) cos
+        assert a == pytest.approx(z.real, rel=1e-5, abs=1e-9)
+        assert b == pytest.approx(z.imag, rel=1e-5, abs=1e-9)
+    # undamped natural frequencies of the closed form, as the model file states them
+    w2 = np.sort(np.linalg.eigvals(np.linalg.solve(M, K)).real)
+    assert np.sqrt(w2) / (2 * np.pi) == pytest.approx([1.213, 11.29], rel=1e-3)
+    assert res.stats["energy_drift"] < 1e-6
