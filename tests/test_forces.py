@@ -262,6 +262,7 @@ def test_generalized_forces_are_minus_the_gradient_of_the_potential():
             assert np.abs(f + grad).max() < 1e-5 * max(1.0, np.abs(f).max()), name
 
 
+@pytest.mark.filterwarnings("ignore:model 'all elements'. the gyroscopic effect is off")
 def test_non_conservative_power_matches_the_damping_forces():
     """The power dampers, bushings and bearings report equals u . f of their forces."""
     s = every_kind_system()
@@ -474,3 +475,21 @@ def test_quarter_car_steady_response_matches_the_transfer_function():
     w2 = np.sort(np.linalg.eigvals(np.linalg.solve(M, K)).real)
     assert np.sqrt(w2) / (2 * np.pi) == pytest.approx([1.213, 11.29], rel=1e-3)
     assert res.stats["energy_drift"] < 1e-6
+
+
+def test_symbolic_loads_on_massless_frames_count():
+    """Regression: the symbolic Jourdain form skipped massless frames even when loaded."""
+    from mbdyn.symbolic.compare import compare_numerically
+    s = mb.System("carriage", gravity=(0, 0, -9.81))
+    s.add_frame("carriage")
+    s.add_joint("x", "prismatic", parent="ground", child="carriage", axis="x")
+    s.add_body("bob", mass=1.0, com=(0, 0, -0.5), inertia=[0.01, 0.01, 0.01])
+    s.add_joint("th", "revolute", parent="carriage", child="bob", axis="y")
+    s.add_force("spring", "spring-damper", body_a="ground", point_a=(-1, 0, 0),
+                body_b="carriage", stiffness=40.0, damping=1.0, free_length=1.0)
+    s.add_load("push", "carriage", force=(3.0, 0, 0))
+    model = s.compile()
+    for method in ("jourdain", "newton-euler", "lagrange"):
+        d = mb.derive(model, method=method, solve=method == "newton-euler")
+        what = ("accelerations",) if method == "newton-euler" else ("forcing",)
+        assert max(compare_numerically(d, what=what).values()) < 1e-12, method

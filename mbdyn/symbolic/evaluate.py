@@ -46,6 +46,8 @@ def evaluate(exprs, values):
                 r = ev(b) ** ev(x)
         elif type(e) in _FUNCS:
             r = _FUNCS[type(e)](*[ev(a) for a in e.args])
+        elif hasattr(type(e), "_imp_"):          # a tabulated coefficient
+            r = float(type(e)._imp_(*[ev(a) for a in e.args]))
         else:
             r = float(e.evalf(subs=values))
         memo[e] = r
