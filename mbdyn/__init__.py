@@ -13,6 +13,8 @@ from .model import GROUND, System
 from .simulate import FIXED_STEP, INTEGRATORS, Event, Result, simulate
 from .io import ModelFileError, Scene, load_model
 from .symbolic import derive
+from .analysis import (Campbell, Equilibrium, EquilibriumError, Linearization, Modes,
+                       campbell, equilibrium, linearize, modes)
 
 __version__ = "0.1.0"
 
@@ -20,4 +22,5 @@ __all__ = ["System", "Model", "Kinematics", "Result", "Event", "simulate", "iner
            "GROUND", "INTEGRATORS", "FIXED_STEP", "ModelError", "ModelWarning",
            "NonFiniteError", "SimulationError", "SingularityWarning",
            "SingularMassMatrixError", "load_model", "Scene", "ModelFileError", "derive",
-           "forces", "effects"]
+           "forces", "effects", "equilibrium", "linearize", "modes", "campbell",
+           "Equilibrium", "EquilibriumError", "Linearization", "Modes", "Campbell"]

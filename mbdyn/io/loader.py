@@ -125,6 +125,8 @@ def load_model(path, case=None, overrides=None, effects=None):
     builder = _SceneBuilder(path, merged, checker, effects)
     scene = builder.build()
     scene.case = chosen
+    scene.overrides = list(_normalise_overrides(overrides))
+    scene.effects_spec = effects
     scene.cases = tuple(cases)
     scene.default_case = default_case
     for message, category in builder.emitted:
@@ -168,6 +170,14 @@ class Scene:
     def __repr__(self):
         case = f", case {self.case!r}" if self.case else ""
         return f"<Scene {self.name!r} from {self.path}{case}: {self.model!r}>"
+
+    def rebuild(self, overrides=None):
+        """The same file, case, overrides and effects, with further ``overrides``
+        (``{"parameters.Omega": 300}``) applied last: a new ``Scene``."""
+        return load_model(self.path, case=self.case,
+                          overrides=list(getattr(self, "overrides", [])) +
+                          _normalise_overrides(overrides),
+                          effects=getattr(self, "effects_spec", None))
 
     @property
     def initial_state(self):
