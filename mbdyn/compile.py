@@ -223,7 +223,7 @@ class Model:
         self.effects = dict(effects) if effects is not None else dict.fromkeys(
             ("gravity", "gyroscopic") + self.loads + self.forces, True)
         self.gyroscopic = bool(self.effects.get("gyroscopic", True))
-        self._force_int, self._force_data = pack_forces(self, forces)
+        self._force_int, self._force_data, laws = pack_forces(self, forces)
         self._switches = np.array([1 if self.gyroscopic else 0], np.int64)
         # -- workspace
         self._qfull = np.zeros(nqf)
@@ -251,8 +251,11 @@ class Model:
         #: (load name, the row of the load array its function fills, the function)
         self._load_functions = [(name, getattr(self, target)[k], fn)
                                 for name, target, k, fn in load_functions]
-        #: drives or function loads: values Python writes before each compiled evaluation
-        self._python_inputs = bool(self._driven or self._load_functions)
+        #: force laws evaluated in Python: (element, its force slot in the packed data, law)
+        self._laws = laws
+        #: drives, function loads or force laws: values Python writes before each compiled
+        #: evaluation
+        self._python_inputs = bool(self._driven or self._load_functions or self._laws)
         self._tree = (self._parent, self._kind, self._axis, self._seq, self._pos, self._C,
                       self._qoff, self._uoff, self._ucol, self._anc_ptr, self._anc_idx)
         self._loads_arrays = (self._load_body, self._load_point, self._load_force,
@@ -408,12 +411,57 @@ class Model:
             self._qfull[kq] = drive.position(t)
             self._ufull[ku] = drive.velocity(t)
             self._udfull[ku] = drive.acceleration(t)
+        if self._laws:
+            self._fill_laws(q, u, t)
         for name, row, fn in self._load_functions:
             val = np.asarray(fn(t, q, u), dtype=float).reshape(-1)
             if val.shape != (3,):
                 raise ModelError(f"load {name!r}: its function returned {val.size} values at "
                                  f"t={t}; it must return three")
             row[:] = val
+
+    def _fill_laws(self, q, u, t):
+        """Each force law's value at the state: ``law(x, x')`` of a spring-damper's
+        elongation or a joint's coordinate offset, written where the kernel reads it."""
+        self._qfull[self._free_q] = q
+        self._ufull[self._free_u] = u
+        kinematics_done = False
+        fd = self._force_data
+        for el, slot, law in self._laws:
+            p = el.params
+            if el.kind == "joint-spring-damper":
+                j = self._joint[p["joint"]]
+                i = self._frame_index[j.child]
+                x = self._qfull[self._qoff[i]] - p["rest"]
+                v = self._ufull[self._uoff[i]]
+            else:
+                if not kinematics_done:
+                    from .kernels.kinematics import forward_kinematics
+                    forward_kinematics(*self._tree, self._qfull, self._ufull, self._udfull,
+                                       *self._kin_out[:8])
+                    kinematics_done = True
+                ends = []
+                for frame, point in zip(el.frames, (p["point_a"], p["point_b"])):
+                    if frame == "ground":
+                        ends.append((point, np.zeros(3)))
+                    else:
+                        i = self._frame_index[frame]
+                        lever = self._R[i] @ point
+                        ends.append((self._r[i] + lever, self._v[i] + np.cross(self._w[i], lever)))
+                d = ends[1][0] - ends[0][0]
+                L = float(np.sqrt(d @ d))
+                e = d / np.sqrt(L * L + p["min_length"] ** 2)
+                x = L - p["free_length"]
+                v = float(e @ (ends[1][1] - ends[0][1]))
+            try:
+                value = float(law(x, v))
+            except Exception as exc:
+                raise ModelError(f"force {el.name!r}: its law failed at x={x:.6g}, v={v:.6g} "
+                                 f"(t={t:.6g}): {type(exc).__name__}: {exc}") from None
+            if not np.isfinite(value):
+                raise NonFiniteError(f"model {self.name!r}, t={t:.6g}: the law of force "
+                                     f"{el.name!r} gave {value} at x={x:.6g}, v={v:.6g}")
+            fd[slot] = value
 
     def _check_finite(self, q, u, t, out, what, names=None):
         if np.all(np.isfinite(out)):
@@ -704,7 +752,7 @@ class Model:
     @property
     def has_callable_loads(self):
         """True when some load is a Python function (compiled loops cannot call it)."""
-        return bool(self._load_functions)
+        return bool(self._load_functions or self._laws)
 
     def drive_values(self, times):
         """``(len(times), n_drives, 3)``: each drive's ``q, q', q''`` at ``times``."""

@@ -35,8 +35,9 @@ def speed_slot(model, name, element):
 
 
 def pack_forces(model, forces):
-    """``(force_int, force_data)`` for the enabled force elements."""
-    rows, data = [], []
+    """``(force_int, force_data, laws)`` for the enabled force elements; ``laws`` lists
+    ``(element, data index of its force slot, law)`` for the laws evaluated in Python."""
+    rows, data, laws = [], [], []
 
     def put(values):
         at = len(data)
@@ -63,6 +64,9 @@ def pack_forces(model, forces):
             row[:4] = [kf.SPRING_DAMPER, ia, ib, off]
             row[4:6] = put_table(p["force_table"])
             row[6:8] = put_table(p["damping_table"])
+            if p.get("law") is not None:
+                row[5] = kf.LAW
+                laws.append((el, off + 9, p["law"]))
         elif el.kind == "joint-spring-damper":
             name = p["joint"]
             if name not in model._joint:
@@ -80,6 +84,9 @@ def pack_forces(model, forces):
             row[4:6] = put_table(p["force_table"])
             row[6:8] = put_table(p["damping_table"])
             row[8:10] = [int(model._qoff[i]), int(model._uoff[i])]
+            if p.get("law") is not None:
+                row[5] = kf.LAW
+                laws.append((el, off + 3, p["law"]))
         elif el.kind == "bushing":
             ia, ib = (_frame(model, n, element) for n in el.frames)
             if ia == ib:
@@ -118,7 +125,7 @@ def pack_forces(model, forces):
         rows.append(row)
     force_int = np.array(rows, np.int64).reshape(len(rows), kf.ROW)
     force_data = np.array(data, float)
-    return force_int, force_data
+    return force_int, force_data, laws
 
 
 def warn_outside_tables(model, t, u):

@@ -140,7 +140,9 @@ class ForceElement:
         """One line for ``mbdyn info``."""
         p = self.params
         if self.kind == "spring-damper":
-            law = ("force table" if p["force_table"] is not None else
+            law = ("law " + (str(p["law"].expression) if p["law"].expression is not None
+                             else "(a function)") if p["law"] is not None else
+                   "force table" if p["force_table"] is not None else
                    f"k = {p['stiffness']:g}, free length {p['free_length']:g}"
                    + (f", preload {p['preload']:g}" if p["preload"] else "")
                    if p["stiffness"] or p["preload"] else "")
@@ -174,6 +176,50 @@ def radial_directions(axis):
     e1 = helper - (helper @ axis) * axis
     e1 /= np.linalg.norm(e1)
     return e1, np.cross(axis, e1)
+
+
+@dataclass(frozen=True)
+class Law:
+    """A force law ``law(x, v)`` of an elongation (or coordinate offset) ``x`` and its rate
+    ``v``: ``function`` for the numbers, ``expression`` (sympy, in the symbols ``x`` and
+    ``v`` and the system's parameters) when it was given as one, for the symbolic layer."""
+    function: object
+    expression: object = None
+
+    def __call__(self, x, v):
+        return self.function(x, v)
+
+
+def make_law(law, parameters, element):
+    """A ``Law`` from a callable ``f(x, v)`` or a sympy expression of ``x`` and ``v``."""
+    if law is None:
+        return None
+    if callable(law) and not hasattr(law, "free_symbols"):
+        return Law(law)
+    import sympy
+    if not isinstance(law, sympy.Basic):
+        raise ModelError(f"{element}: law must be a function f(x, v) or a sympy expression of "
+                         "x (elongation) and v (its rate)")
+    named = {s.name: s for s in law.free_symbols}
+    extra = sorted(set(named) - {"x", "v"} - set(parameters))
+    if extra:
+        raise ModelError(f"{element}: law uses {', '.join(extra)}, which are neither x, v nor "
+                         "parameters of the system")
+    numeric_law = law.subs({named[n]: parameters[n] for n in named if n in parameters})
+    xs, vs = sympy.Symbol("x"), sympy.Symbol("v")
+    numeric_law = numeric_law.subs({s: (xs if s.name == "x" else vs)
+                                    for s in numeric_law.free_symbols})
+    fn = sympy.lambdify((xs, vs), numeric_law, "math")
+    return Law(lambda x, v: float(fn(x, v)), law)
+
+
+def _check_law(kw, element):
+    if kw.get("law") is not None:
+        clash = [k for k in ("stiffness", "damping", "force_table", "damping_table", "preload")
+                 if kw.get(k) is not None]
+        if clash:
+            raise ModelError(f"{element}: law gives the whole force; remove "
+                             f"{', '.join(clash)} (or drop the law)")
 
 
 def _number(value, parameters, element, what, minimum=None, positive=False):
@@ -240,11 +286,12 @@ def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):
     if kind == "spring-damper":
         _unknown_keys(kw, ("body_a", "point_a", "body_b", "point_b", "stiffness", "damping",
                            "free_length", "preload", "force_table", "damping_table",
-                           "interpolation", "min_length"), element, kind)
+                           "interpolation", "min_length", "law"), element, kind)
         if "body_a" not in kw:
             raise ModelError(f"{element}: give body_a (and body_b, default the ground)")
+        _check_law(kw, element)
         if all(kw.get(k) is None for k in ("stiffness", "force_table", "damping",
-                                            "damping_table")):
+                                            "damping_table", "law")):
             raise ModelError(f"{element}: missing stiffness: give stiffness (and free_length), "
                              "a force_table, or damping")
         if kw.get("stiffness") is not None and kw.get("force_table") is not None:
@@ -263,6 +310,7 @@ def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):
             "force_table": table("force_table"),
             "damping_table": table("damping_table"),
             "min_length": num(kw.get("min_length", 1e-9), what="min_length", positive=True),
+            "law": make_law(kw.get("law"), parameters, element),
         }
         dt = params["damping_table"]
         if dt is not None and np.any(np.diff(dt.y) < 0):
@@ -272,11 +320,12 @@ def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):
         frames = (kw["body_a"], kw.get("body_b", "ground"))
     elif kind == "joint-spring-damper":
         _unknown_keys(kw, ("joint", "stiffness", "damping", "rest", "preload", "force_table",
-                           "damping_table", "interpolation"), element, kind)
+                           "damping_table", "interpolation", "law"), element, kind)
         if "joint" not in kw:
             raise ModelError(f"{element}: give the joint whose coordinate it acts on")
+        _check_law(kw, element)
         if all(kw.get(k) is None for k in ("stiffness", "force_table", "damping",
-                                            "damping_table")):
+                                            "damping_table", "law")):
             raise ModelError(f"{element}: missing stiffness: give stiffness (and rest), a "
                              "force_table, or damping")
         params = {
@@ -287,6 +336,7 @@ def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):
             "preload": num(kw.get("preload", 0.0), what="preload"),
             "force_table": table("force_table"),
             "damping_table": table("damping_table"),
+            "law": make_law(kw.get("law"), parameters, element),
         }
         frames = ()
     elif kind == "bushing":

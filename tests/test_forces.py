@@ -493,3 +493,56 @@ def test_symbolic_loads_on_massless_frames_count():
         d = mb.derive(model, method=method, solve=method == "newton-euler")
         what = ("accelerations",) if method == "newton-euler" else ("forcing",)
         assert max(compare_numerically(d, what=what).values()) < 1e-12, method
+
+
+# ----------------------------------------------------------------------------- force laws
+def test_force_law_as_an_expression_matches_the_same_linear_spring():
+    """law = k x + c v is the linear spring-damper: the same accelerations, in both
+    formulations, and in closed form."""
+    import sympy
+    x, v = sympy.symbols("x v")
+    lin = oscillator(k=800.0, c=4.0).compile()
+    s = oscillator(k=None, c=0.0) if False else None
+    s = mb.System("law", gravity=(0, 0, -9.81), parameters={"k": 800.0, "c": 4.0})
+    k, c = s.symbols("k c")
+    s.add_body("block", mass=2.0)
+    s.add_joint("x", "prismatic", parent="ground", child="block", axis="x")
+    s.add_force("spring", "spring-damper", body_a="ground", point_a=(-0.5, 0, 0),
+                body_b="block", free_length=0.5, law=k * x + c * v)
+    law = s.compile()
+    rng = np.random.default_rng(2)
+    for _ in range(5):
+        q, u = rng.uniform(-0.2, 0.2, 1), rng.uniform(-1, 1, 1)
+        for method in ("jourdain", "newton-euler"):
+            assert law.forward_dynamics(q, u, method=method) == pytest.approx(
+                lin.forward_dynamics(q, u, method=method), rel=1e-13)
+    from mbdyn.symbolic.compare import compare_numerically
+    assert max(compare_numerically(mb.derive(law)).values()) < 1e-12
+    # a law is non-conservative in the energy balance: its whole power is "dissipated"
+    res = mb.simulate(law, 1.0, {"x": 0.1}, integrator="DOP853", rtol=1e-11, atol=1e-13,
+                      t_eval=np.linspace(0, 1, 2001), outputs=("energy",))
+    assert res.stats["energy_drift"] < 1e-7
+
+
+def test_progressive_law_from_a_model_file_and_a_python_function(tmp_path):
+    text = (MODELS / "mass_spring_damper.toml").read_text()
+    text = text.replace('stiffness = "k"', 'law = "k*x + 4*k*x**3/L0**2"')
+    path = tmp_path / "law.toml"
+    path.write_text(text)
+    model = mb.load_model(path).model
+    q = np.array([0.2])
+    f = model.forcing(q, [0.0])
+    assert f[0] == pytest.approx(-(800 * 0.2 + 4 * 800 * 0.2 ** 3 / 0.25), rel=1e-12)
+    s = oscillator(c=0.0, k=None) if False else mb.System("fn", gravity=(0, 0, 0))
+    s.add_body("block", mass=2.0)
+    s.add_joint("x", "prismatic", parent="ground", child="block", axis="x")
+    s.add_force("stop", "joint-spring-damper", joint="x",
+                law=lambda x, v: 1e4 * max(x - 0.1, 0.0) ** 2 + 3.0 * v)
+    m = s.compile()
+    assert m.forcing([0.15], [0.5])[0] == pytest.approx(-(1e4 * 0.05 ** 2 + 1.5), rel=1e-12)
+    with pytest.raises(ModelError, match="law gives the whole force; remove stiffness"):
+        s.add_force("bad", "joint-spring-damper", joint="x", stiffness=1.0,
+                    law=lambda x, v: x)
+    s.add_force("nan", "joint-spring-damper", joint="x", law=lambda x, v: float("nan"))
+    with pytest.raises(mb.NonFiniteError, match="law of force 'nan'"):
+        s.compile(check_inertia=False).forcing([0.0], [0.0])

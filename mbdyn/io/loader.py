@@ -518,6 +518,14 @@ class _SceneBuilder:
                     kw[key] = self.pvector(value, kpath)
                 elif key in ("axis", "plane_normal"):
                     kw[key] = value if isinstance(value, str) else self.pvector(value, kpath)
+                elif key == "law":
+                    for n in ("x", "v"):
+                        if n in self.P:
+                            raise self.error(kpath, f"a law's variables are x (elongation) and "
+                                             f"v (its rate), but {n!r} is also a parameter; "
+                                             "rename the parameter")
+                    kw[key] = self.expr(value, kpath, dict(self.P, x=symbol("x"),
+                                                          v=symbol("v")))
                 elif key in ("force_table", "damping_table"):
                     kw[key] = [[self.number(x, kpath + (r, 0)), self.number(y, kpath + (r, 1))]
                                for r, (x, y) in enumerate(value)]

@@ -30,7 +30,7 @@ from .linalg3 import cross_to, mat_t_vec, mat_vec
 SPRING_DAMPER, JOINT_SPRING_DAMPER, BUSHING, BEARING, CONTACT_SPHERE, CONTACT_DISK = 1, 2, 3, 4, 5, 6
 KIND_CODES = {"spring-damper": SPRING_DAMPER, "joint-spring-damper": JOINT_SPRING_DAMPER,
               "bushing": BUSHING, "bearing": BEARING, "contact": CONTACT_SPHERE}
-NO_TABLE, LINEAR, PCHIP = 0, 1, 2
+NO_TABLE, LINEAR, PCHIP, LAW = 0, 1, 2, 3      # LAW: a law evaluated in Python, given as preload
 ROW = 10          # entries of a force_int row
 
 
@@ -132,6 +132,9 @@ def _law(data, spring_off, spring_mode, damper_off, damper_mode, k, c, F0, x, xd
     if spring_mode == NO_TABLE:
         fs = F0 + k * x
         V = F0 * x + 0.5 * k * x * x
+    elif spring_mode == LAW:            # the caller wrote law(x, x') into the preload slot
+        fs = F0
+        V = 0.0
     else:
         table_eval(data, spring_off, spring_mode, 0.0, tmp)
         V0 = tmp[2]
@@ -186,7 +189,7 @@ def force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r,
             _apply(ib, pb, f, zero, -1.0, R, r, com, F, N, lever, t)
             if want:
                 acc[0] += V
-                acc[1] -= fd * xd
+                acc[1] -= (T if force_int[e, 5] == LAW else fd) * xd
         elif kind == JOINT_SPRING_DAMPER:
             # frame_a: the joint's child frame; index1/index2: joint-space q and u entries;
             # data: rest value, k, c, preload, prismatic (1) or revolute (0)
@@ -210,7 +213,7 @@ def force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r,
                 _apply(parent[i], pa, zero, e1, -1.0, R, r, com, F, N, lever, t)
             if want:
                 acc[0] += V
-                acc[1] -= fd * xd
+                acc[1] -= ((fs + fd) if force_int[e, 5] == LAW else fd) * xd
         elif kind == BUSHING:
             # data: point_a(3), point_b(3), K (6x6 row-major), C (6x6), all in frame a's
             # axes; x = (translation, small rotation) of b relative to a

@@ -479,13 +479,20 @@ class Walk:
                                  "and dampers in closed form, not tabulated laws; switch it off "
                                  f"to derive the rest (--effects=-{el.name})")
             vec = lambda key: exact_vector(el.symbolic.get(key, p[key]), self.sym.table)  # noqa
+            law = p.get("law")
+            if law is not None and law.expression is None:
+                raise ModelError(f"force {el.name!r}: its law is a Python function; the symbolic "
+                                 "layer needs it as an expression of x and v (or switch it off: "
+                                 f"--effects=-{el.name})")
             if el.kind == "spring-damper":
                 k, c, F0 = (self._param(el, key) for key in ("stiffness", "damping", "preload"))
                 pa, pb = vec("point_a"), vec("point_b")
                 a, b = el.frames
                 d = self._world_point(b, pb) - self._world_point(a, pa)
                 L = sympy.sqrt((d.T * d)[0])
-                T = F0 + k * (L - self._param(el, "free_length")) + c * self.D(L)
+                x = L - self._param(el, "free_length")
+                T = (self._law(law, x, self.D(L)) if law is not None
+                     else F0 + k * x + c * self.D(L))
                 f = d * (T / L)
                 self._add_wrench(el.name, a, f, Z3, pa)
                 self._add_wrench(el.name, b, -f, Z3, pb)
@@ -494,7 +501,7 @@ class Walk:
                 joint = next(j for j in self.joints if j.name == p["joint"])
                 qj, uj, _, driven = self.joint_values[joint.name]
                 x = qj[0] - self._param(el, "rest")
-                tau = -(F0 + k * x + c * uj[0])
+                tau = -(self._law(law, x, uj[0]) if law is not None else F0 + k * x + c * uj[0])
                 m = self.by_name[joint.child]
                 axis = self._joint_geometry(joint)[0]
                 # the axis in world components: joint frame J0 = child axes along the axis
@@ -567,6 +574,13 @@ class Walk:
                 f = (fn * n + ft * vt).applyfunc(
                     lambda e: sympy.Piecewise((e, delta > 0), (0, True)))
                 self._add_wrench(el.name, a, f, Z3, own)
+
+    def _law(self, law, x, v):
+        """A law's expression with the elongation ``x`` and its rate ``v`` put in."""
+        e = law.expression
+        e = e.xreplace({s: (x if s.name == "x" else v) for s in e.free_symbols
+                        if s.name in ("x", "v")})
+        return canonical(e, self.sym.table)
 
     def _world_velocity(self, frame):
         """World velocity of a frame's origin."""
