@@ -339,3 +339,20 @@ def test_commands_json_and_plot(tmp_path):
     out = run_cli("campbell", "models/jeffcott_rotor.toml", "--parameter", "Omega",
                   "--values", "1:2:1")
     assert out.returncode == 1 and "START:STOP:N" in out.stderr
+
+
+def test_geometric_stiffness_of_a_preloaded_spring():
+    """A string under tension T resists a sideways displacement with stiffness T / L (its
+    own stiffness k acts only along it): both routes, and the string's frequency."""
+    L, T, k, m = 0.8, 50.0, 3000.0, 0.4
+    s = mb.System("string", gravity=(0, 0, 0))
+    s.add_body("bead", mass=m)
+    s.add_joint("y", "prismatic", parent="ground", child="bead", axis="y")
+    s.add_force("string", "spring-damper", body_a="ground", point_a=(-L, 0, 0),
+                body_b="bead", stiffness=k, free_length=L, preload=T)
+    model = s.compile()
+    for route in ("numeric", "symbolic"):
+        lin = mb.linearize(model, route=route)
+        assert lin.K[0, 0] == pytest.approx(T / L, rel=1e-7), route
+    assert mb.modes(mb.linearize(model))[0].natural_frequency == pytest.approx(
+        np.sqrt(T / (L * m)), rel=1e-7)
