@@ -340,7 +340,22 @@ class Model:
                             "coordinate")
 
     def u_vector(self, values=None):
-        """Speeds as an array from an array, or a mapping ``{name: value}`` over zeros."""
+        """Speeds as an array from an array, or a mapping ``{name: value}`` over zeros; as
+        in model files, a revolute, prismatic or Euler-angle coordinate's name stands for
+        its rate (``{"theta": 1}`` sets ``theta_dot``)."""
+        if isinstance(values, dict):
+            rates = {}
+            for j in self.elements[1]:
+                if j.drive is None and j.kind in ("revolute", "prismatic", "euler"):
+                    rates.update(zip(j.coordinates, j.speeds))
+            mapped = {}
+            for k, v in values.items():
+                target = k if k in self._speed_index else rates.get(k, k)
+                if target in mapped:
+                    raise ModelError(f"speed {target!r} is given twice ({k!r} stands for it); "
+                                     "keep one of the two")
+                mapped[target] = v
+            values = mapped
         return self._vector(values, np.zeros(self.nu), self._speed_index, "speed")
 
     def _vector(self, values, default, index, what):

@@ -270,7 +270,17 @@ def _check_inertia_of_every_dof(model, samples=3, seed=12345):
             singular_sets.append(set(exc.coordinates))
     names = sorted(set.intersection(*singular_sets), key=model.speeds.index) or \
         sorted(set.union(*singular_sets), key=model.speeds.index)
+    hint = ""
+    for j in dict.fromkeys(model._speed_joint[model._speed_index[n]] for n in names):
+        joint = model.joint(j)
+        body = model.body(joint.child)
+        if joint.kind in ("spherical", "free") and not np.any(body.inertia):
+            hint = (f"  Joint {j!r} carries a particle ({joint.child!r} has mass but no "
+                    "inertia), whose spin about its own lever carries none: use two revolute "
+                    "joints instead, or give the body a small isotropic inertia (e.g. "
+                    "inertia=[1e-9, 1e-9, 1e-9]), which leaves its translation and conical "
+                    "motion exact and only adds an unobservable spin.")
     raise ModelError(f"system {model.name!r}: the degrees of freedom {model.describe_speeds(names)} "
                      "carry no inertia -- the mass matrix is singular in every configuration.  "
                      "Give the bodies these joints move mass or inertia about the joint axes, "
-                     "or remove (fix) those joints.")
+                     "or remove (fix) those joints." + hint)

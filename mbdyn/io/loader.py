@@ -25,6 +25,7 @@ from .. import compile as _compile
 from ..elements import t as TIME
 from ..errors import ModelError
 from ..model import GROUND, System
+from ..simulate import DEFAULTS as SIMULATE_DEFAULTS
 from ..simulate import FIXED_STEP, INTEGRATORS, Event, Result
 from ..simulate import simulate as _simulate
 from .errors import ModelFileError
@@ -37,8 +38,7 @@ from .schema import (DIRECTIONS, Checker, _suggest, apply_case, apply_override,
 METHODS = tuple(_compile.METHODS) + ("symbolic",)
 
 #: ``[simulation]`` defaults.
-DEFAULT_SIMULATION = {"integrator": "DOP853", "method": "jourdain", "rtol": 1e-9,
-                      "atol": 1e-12}
+DEFAULT_SIMULATION = dict(SIMULATE_DEFAULTS)     # one set of defaults (mbdyn.simulate)
 SIMULATE_KEYWORDS = ("t_end", "integrator", "method", "rtol", "atol", "dt", "max_step",
                      "output_dt", "progress", "events", "outputs", "points")
 
