@@ -16,6 +16,11 @@ from .symbolic import derive
 from .analysis import (Campbell, Equilibrium, EquilibriumError, Linearization, Modes,
                        campbell, equilibrium, linearize, modes)
 
+from . import viz
+
+#: ``Result.plot(series=None, phase=None, out=None)``: see ``mbdyn.viz.plot_result``
+Result.plot = viz.plot_result
+
 __version__ = "0.1.0"
 
 __all__ = ["System", "Model", "Kinematics", "Result", "Event", "simulate", "inertia", "t",

@@ -17,7 +17,7 @@ import os
 import sys
 import warnings
 
-COMMANDS = ["run", "info", "eom", "accuracy", "equilibrium", "modes", "campbell"]
+COMMANDS = ["run", "info", "eom", "accuracy", "equilibrium", "modes", "campbell", "plot"]
 
 EXIT_OK, EXIT_INPUT, EXIT_USAGE, EXIT_SIMULATION, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 
