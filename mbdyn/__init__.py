@@ -20,6 +20,8 @@ from . import viz
 
 #: ``Result.plot(series=None, phase=None, out=None)``: see ``mbdyn.viz.plot_result``
 Result.plot = viz.plot_result
+#: ``Result.animate(out, speed=1.0, fps=30.0)``: see ``mbdyn.viz.animate``
+Result.animate = viz.animate
 
 __version__ = "0.1.0"
 

@@ -76,18 +76,21 @@ class System:
             raise ModelError(f"body/frame {name!r}: the name is already used by {what}; "
                              "choose another name")
 
-    def add_body(self, name, mass=0.0, com=(0, 0, 0), inertia=None):
+    def add_body(self, name, mass=0.0, com=(0, 0, 0), inertia=None, shape=None):
         """A rigid body: ``mass``, centre of mass ``com`` in body components (from the
         frame origin), ``inertia`` about the centre of mass in body axes -- ``None``/0 for a
-        particle, three principal moments, or a 3x3 tensor (see ``mbdyn.inertia``)."""
+        particle, three principal moments, or a 3x3 tensor (see ``mbdyn.inertia``).
+        ``shape``: how pictures draw it (``mbdyn.elements.make_shape``)."""
         self._check_new_frame(name)
-        self.graph.add_node(name, body=make_body(name, mass, com, inertia, self.parameters))
+        self.graph.add_node(name, body=make_body(name, mass, com, inertia, self.parameters,
+                                                 shape))
         return name
 
-    def add_frame(self, name):
-        """A massless frame (e.g. a gimbal ring or an intermediate joint frame)."""
+    def add_frame(self, name, shape=None):
+        """A massless frame (e.g. a gimbal ring or an intermediate joint frame); ``shape``
+        draws it (an arm, a disk)."""
         self._check_new_frame(name)
-        self.graph.add_node(name, body=make_body(name))
+        self.graph.add_node(name, body=make_body(name, shape=shape))
         return name
 
     def add_joint(self, name, kind, parent, child, *, axis=None, position=(0, 0, 0),

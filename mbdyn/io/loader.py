@@ -413,8 +413,19 @@ class _SceneBuilder:
                     raise self.error(path + ("inertia_about",), "\"origin\" needs an inertia "
                                      "to convert; give inertia = [...] or remove inertia_about")
                 inertia = _inertia_about_com(inertia, mass, com)
+            shape = None
+            if "shape" in b:
+                shape = dict(b["shape"])
+                for key in ("radius", "length"):
+                    if key in shape:
+                        shape[key] = self.number(shape[key], path + ("shape", key),
+                                                 positive=True)
+                for key in ("center", "start", "end", "size"):
+                    if key in shape:
+                        shape[key] = [self.number(v, path + ("shape", key, k))
+                                      for k, v in enumerate(shape[key])]
             with self.engine(path):
-                self.system.add_body(name, mass=mass, com=com, inertia=inertia)
+                self.system.add_body(name, mass=mass, com=com, inertia=inertia, shape=shape)
             self.body_specs.append(dict(b))
 
     def joints(self):

@@ -23,7 +23,10 @@ from .expressions import RESERVED, ExpressionError, parse, parse_condition
 MODEL_KEYS = {"name": "string", "description": "string", "gravity": "vector",
               "default_case": "string"}
 BODY_KEYS = {"name": "name", "mass": "expr", "com": "vector", "inertia": "inertia",
-             "inertia_about": ("choice", ("com", "origin"))}
+             "inertia_about": ("choice", ("com", "origin")), "shape": "shape"}
+SHAPE_KEYS = {"type": ("choice", ("sphere", "box", "cylinder", "disk", "rod")),
+              "radius": "expr", "length": "expr", "size": "vector", "center": "vector",
+              "start": "vector", "end": "vector", "axis": "axis", "color": "string"}
 JOINT_KINDS = ("revolute", "prismatic", "euler", "spherical", "fixed", "free")
 JOINT_KEYS = {"name": "name", "kind": ("choice", JOINT_KINDS), "parent": "name",
               "child": "name", "axis": "axis", "position": "vector",
@@ -332,6 +335,8 @@ class Checker:
                 return
             if not isinstance(value, list) or not all(isinstance(n, str) for n in value):
                 raise fail(path, "must be true, false or an array of joint names")
+        elif kind == "shape":
+            self.check_table(value, SHAPE_KEYS, path, required=("type",))
         elif kind == "exprs":
             if not isinstance(value, list) or not value:
                 raise fail(path, f"must be an array of numbers, got {_show(value)}")
