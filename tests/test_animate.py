@@ -168,3 +168,17 @@ def test_animate_command(tmp_path):
                        capture_output=True, text=True, cwd=ROOT, timeout=600)
     assert r.returncode == 0, r.stderr
     assert "frames" in r.stdout and out.stat().st_size > 10000
+
+
+def test_mode_shape_animation(tmp_path):
+    from mbdyn.viz.modeshape import animate_mode, mode_motion
+    scene = mb.load_model(ROOT / "models/double_pendulum.toml")
+    lin = mb.linearize(scene.model)
+    mode = mb.modes(lin)[1]
+    res = mode_motion(lin, mode, amplitude=0.05)
+    # the motion is the mode: the two angles keep the shape's ratio, at its frequency
+    k = np.argmax(np.abs(res["theta1"]) > 1e-3)
+    assert res["theta2"][k] / res["theta1"][k] == pytest.approx(
+        (mode.shape[1] / mode.shape[0]).real, rel=1e-9)
+    n = animate_mode(lin, mode, tmp_path / "mode.gif", period_seconds=1.0, fps=25)
+    assert n == int(2 * 25) + 1

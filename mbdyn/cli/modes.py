@@ -25,6 +25,12 @@ def register(subparsers):
                    help="derivatives by central differences (default) or from the closed-form "
                         "equations")
     p.add_argument("--matrices", action="store_true", help="also print M, D, G, K, N")
+    p.add_argument("--animate", metavar="FILE", help="animate a mode shape about the "
+                   "operating point: .gif, .mp4 or .html")
+    p.add_argument("--mode", type=int, default=1, metavar="K",
+                   help="which mode --animate draws (1 = the lowest, as listed)")
+    p.add_argument("--amplitude", type=float, default=0.1,
+                   help="--animate's amplitude in the tangent coordinates (rad or m)")
     add_vibration_arguments(p)
     p.set_defaults(func=run)
 
@@ -42,8 +48,18 @@ def run(args):
     if args.at == "equilibrium":
         eq = equilibrium(model, q, u, t=args.t, fixed=names(args.fixed))
         q = eq.q
+    if args.animate:
+        from ..viz.animate import check_output
+        check_output(args.animate)
     lin = linearize(model, q, u, t=args.t, route=args.route)
     md = modes(lin, whirl=whirl_pairs(args))
+    if args.animate:
+        from ..errors import ModelError
+        from ..viz.modeshape import animate_mode
+        if not 1 <= args.mode <= len(md):
+            raise ModelError(f"--mode {args.mode}: the model has modes 1 to {len(md)}")
+        animate_mode(lin, md[args.mode - 1], args.animate, amplitude=args.amplitude)
+        sys.stderr.write(f"mbdyn: wrote {args.animate}\n")
     if args.json:
         sys.stdout.write(json.dumps({"model": scene.name, "case": scene.case, "at": args.at,
                                      "equilibrium": eq.to_dict() if eq else None,
