@@ -4,7 +4,8 @@ coordinates, from the bodies' shapes, or from what the model knows when a body h
 Every body with mass is drawn as a sphere at its centre of mass, sized by its mass
 (relative to the heaviest body), and every joint as a line from the parent frame's origin
 to the child frame's origin and on to the child's centre of mass -- so every model draws
-without edits.  Shapes (``mbdyn.elements.make_shape``) are drawn as wireframes: a box by its
+without edits.  Each frame's axes are drawn at its origin (x red, y green, z blue).
+Shapes (``mbdyn.elements.make_shape``) are drawn as wireframes: a box by its
 edges, a cylinder or disk by its two rims and four lines, a sphere by three great circles,
 a rod as a thick line.
 """
@@ -14,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+#: colours of a frame's x, y, z axes (red, green, blue)
+AXES = ("#e41a1c", "#4daf4a", "#377eb8")
 PALETTE = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
            "#7f7f7f", "#bcbd22", "#17becf")
 
@@ -71,6 +74,9 @@ def model_geometry(model):
     """Static facts for drawing: per frame its shape (or None), colour, marker size, the
     parent index and the joint position."""
     bodies, joints, _ = model.elements
+    lengths = [np.linalg.norm(b.com) for b in bodies] + [np.linalg.norm(j.position)
+                                                          for j in joints]
+    triad = 0.25 * max(max(lengths, default=0.0), 1e-3)
     masses = np.array([b.mass for b in bodies])
     biggest = masses.max() if masses.size and masses.max() > 0 else 1.0
     out = []
@@ -79,7 +85,7 @@ def model_geometry(model):
         size = 6 + 10 * np.cbrt(b.mass / biggest) if b.mass > 0 else 0
         out.append({"name": b.name, "shape": b.shape, "color": colour, "size": float(size),
                     "com": b.com, "parent": int(model._parent[i]), "mass": b.mass,
-                    "attached": j.kind != "free"})
+                    "attached": j.kind != "free", "triad": triad})
     return out
 
 
@@ -94,6 +100,9 @@ def instant(model, geometry, q, u, t):
         if g["shape"] is not None:
             for pts in shape_lines(g["shape"], R, r):
                 lines.append((pts, g["color"], 2.0 if g["shape"]["type"] != "rod" else 4.0))
+        # the frame's axes (x red, y green, z blue) at its origin
+        for k in range(3):
+            lines.append((np.array([r, r + g["triad"] * R[:, k]]), AXES[k], 1.0))
         # the links: parent origin -> joint (this origin) -> centre of mass (a free joint
         # attaches nothing: no line to its parent)
         if g["attached"]:
