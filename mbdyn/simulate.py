@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import time as _time
 import warnings
-from dataclasses import dataclass
 
 import numpy as np
 from scipy import integrate, optimize
 
 from .balance import energy_balance
+from .events import Event, EventRecord, as_event, check_conditions
 from .force_packing import warn_outside_tables
 from .errors import (ModelError, NonFiniteError, SimulationError, SingularityWarning,
                      SingularMassMatrixError)
@@ -28,31 +28,12 @@ INTEGRATORS = tuple(ADAPTIVE) + FIXED_STEP
 OUTPUTS = ("reactions", "energy")
 
 
-@dataclass(frozen=True)
-class Event:
-    """A zero crossing of ``condition(t, q, u)``; ``direction`` +1 (rising), -1 (falling)
-    or 0 (either); a ``terminal`` event stops the run."""
-    name: str
-    condition: object
-    terminal: bool = False
-    direction: int = 0
-
-
-def _as_event(e):
-    if isinstance(e, Event):
-        return e
-    if isinstance(e, dict):
-        return Event(**e)
-    if isinstance(e, (tuple, list)):
-        return Event(*e)
-    raise ModelError(f"event {e!r}: give an mb.Event(name, condition, terminal, direction)")
-
-
 class Result:
     """Time series of a simulation.
 
     ``t`` (n,), ``q`` (n, nq), ``u`` (n, nu); ``res["theta1"]`` gives a coordinate or speed
-    by name; ``events`` is ``[(name, t), ...]``; ``stats`` the integrator's statistics;
+    by name; ``events`` is ``[(name, t), ...]`` (``EventRecord``s: each also carries the
+    state there, ``.q``, ``.u``, ``.state``); ``stats`` the integrator's statistics;
     on request ``reactions`` ``{joint: (n, 6)}`` (force then moment, world components, at
     the joint origin), ``energy`` (see ``mbdyn.balance.energy_balance``: ``kinetic``,
     ``potential``, ``total`` = T + V, ``dissipated``, ``work``, ``balance``) and ``points``
@@ -303,7 +284,9 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     if not (np.all(np.isfinite(q)) and np.all(np.isfinite(u))):
         raise ModelError("initial state must be finite")
     model.normalize_quaternions(q)
-    events = [_as_event(e) for e in events]
+    events = [as_event(e, model) for e in events]
+    if events:
+        check_conditions(events, model, t0, q, u)
     rhs = _RightHandSide(model, method)
     monitor = _Monitor(model, singularity_threshold)
     y0 = np.concatenate([q, u])
@@ -424,7 +407,9 @@ def _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events, 
             for te, e in sorted(hits, key=lambda h: h[0]):
                 if stop_at is not None:
                     break
-                found.append((e.name, te))
+                ye = dense(te)
+                found.append(EventRecord(e.name, te, ye[:model.nq], ye[model.nq:],
+                                         model.coordinates + model.speeds))
                 if e.terminal:
                     stop_at = te
             g_old = g_new
@@ -566,7 +551,10 @@ def _run_fixed(rhs, integrator, t0, t_end, y0, dt, events, t_eval, progress, mon
                         te = t + (t_new - t) * g_old[j] / (g_old[j] - g_new[j])
                         hits.append((te, e))
                 for te, e in sorted(hits, key=lambda x: x[0]):
-                    found.append((e.name, te))
+                    w = (te - t) / (t_new - t) if t_new != t else 1.0
+                    ye = (1 - w) * y + w * y_new
+                    found.append(EventRecord(e.name, te, ye[:model.nq], ye[model.nq:],
+                                             model.coordinates + model.speeds))
                     if e.terminal:
                         stop = True
                         break

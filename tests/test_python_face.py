@@ -43,3 +43,43 @@ def test_a_particle_on_a_spherical_joint_is_refused_with_the_remedy():
     s.add_joint("ball", "spherical", parent="ground", child="bob")
     with pytest.raises(mb.ModelError, match=r"two revolute joints.*small isotropic inertia"):
         s.compile()
+
+
+def swinging():
+    model = pendulum()
+    return model, {"theta": 0.5}
+
+
+def test_events_accept_the_files_text_and_sympy_and_carry_the_state():
+    import sympy
+    model, q0 = swinging()
+    w = np.sqrt(9.81)
+    # small-angle crossings of theta = 0 at (k + 1/2) pi / w; 0.5 rad is not small, so the
+    # reference is a text event against a callable one, both located to 1e-9
+    text = mb.simulate(model, 2.0, q0, events=[mb.Event("cross", "theta")])
+    func = mb.simulate(model, 2.0, q0, events=[mb.Event("cross", lambda t, q, u: q[0])])
+    assert [round(t, 9) for _, t in text.events] == [round(t, 9) for _, t in func.events]
+    assert len(text.events) == 2 and abs(text.events[0].t - 0.5 * np.pi / w) < 0.02
+    down = mb.simulate(model, 2.0, q0, events=[mb.Event("down", "theta < 0")])
+    assert [e.t for e in down.events] == [text.events[0].t]     # falling only
+    th = sympy.Symbol("theta")
+    sym = mb.simulate(model, 2.0, q0, events=[mb.Event("down", th < 0)])
+    assert [e.t for e in sym.events] == pytest.approx([e.t for e in down.events], abs=1e-12)
+    rec = down.events[0]
+    name, t = rec                                   # unpacks as (name, t), as before
+    assert name == "down" and rec.q[0] == pytest.approx(0.0, abs=1e-9)
+    assert rec.state["theta_dot"] == pytest.approx(rec.u[0]) and rec.u[0] < 0
+    # terminal, with the rates named as in files
+    stop = mb.simulate(model, 2.0, q0, events=[mb.Event("turn", "theta_dot > 0", True)])
+    assert stop.t[-1] == pytest.approx(stop.events[0].t)
+
+
+def test_a_bool_condition_is_refused_with_the_remedy():
+    model, q0 = swinging()
+    with pytest.raises(mb.ModelError, match=r"returned .*a bool.*'theta < 0'"):
+        mb.simulate(model, 2.0, q0, events=[mb.Event("down", lambda t, q, u: q[0] < 0)])
+    with pytest.raises(mb.ModelError, match="event 'bad'.*not allowed|event 'bad'"):
+        mb.simulate(model, 1.0, q0, events=[mb.Event("bad", "__import__('os')")])
+    with pytest.raises(mb.ModelError, match="uses phi"):
+        import sympy
+        mb.simulate(model, 1.0, q0, events=[mb.Event("bad", sympy.Symbol("phi"))])
