@@ -16,8 +16,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import ModelError, NonFiniteError, SingularMassMatrixError
+from .force_packing import pack_forces
 from .kernels import dynamics as kd
 from .kernels import evaluate as ke
+from .kernels import forces as kf
 from .kernels import joints as kj
 from .kernels import packed as kp
 from .kernels.kinematics import point_jacobian
@@ -105,7 +107,7 @@ class Model:
     """
 
     def __init__(self, name, bodies, joints, loads, gravity, warnings=(), parameters=None,
-                 gravity_symbolic=None):
+                 gravity_symbolic=None, forces=(), effects=None):
         self.name = name
         self.warnings = tuple(warnings)
         self.gravity = np.array(gravity, dtype=float)
@@ -214,6 +216,15 @@ class Model:
                     load_functions.append((ld.name, target, k, val))
                 else:
                     getattr(self, target)[k] = val
+        # -- force elements and the effects the scene chose (only what is on is here)
+        self._force_elements = tuple(forces)
+        self.forces = tuple(el.name for el in forces)
+        #: ``{effect: on}`` as the scene chose them (see ``mbdyn.effects``)
+        self.effects = dict(effects) if effects is not None else dict.fromkeys(
+            ("gravity", "gyroscopic") + self.loads + self.forces, True)
+        self.gyroscopic = bool(self.effects.get("gyroscopic", True))
+        self._force_int, self._force_data, laws = pack_forces(self, forces)
+        self._switches = np.array([1 if self.gyroscopic else 0], np.int64)
         # -- workspace
         self._qfull = np.zeros(nqf)
         self._ufull = np.zeros(nuf)
@@ -240,12 +251,16 @@ class Model:
         #: (load name, the row of the load array its function fills, the function)
         self._load_functions = [(name, getattr(self, target)[k], fn)
                                 for name, target, k, fn in load_functions]
-        #: drives or function loads: values Python writes before each compiled evaluation
-        self._python_inputs = bool(self._driven or self._load_functions)
+        #: force laws evaluated in Python: (element, its force slot in the packed data, law)
+        self._laws = laws
+        #: drives, function loads or force laws: values Python writes before each compiled
+        #: evaluation
+        self._python_inputs = bool(self._driven or self._load_functions or self._laws)
         self._tree = (self._parent, self._kind, self._axis, self._seq, self._pos, self._C,
                       self._qoff, self._uoff, self._ucol, self._anc_ptr, self._anc_idx)
         self._loads_arrays = (self._load_body, self._load_point, self._load_force,
-                              self._load_moment, self._load_in_body)
+                              self._load_moment, self._load_in_body, self._force_int,
+                              self._force_data, self._switches)
         self._kin_out = (self._R, self._r, self._w, self._v, self._alpha, self._a,
                          self._JR, self._JT, self._F, self._N)
 
@@ -325,7 +340,22 @@ class Model:
                             "coordinate")
 
     def u_vector(self, values=None):
-        """Speeds as an array from an array, or a mapping ``{name: value}`` over zeros."""
+        """Speeds as an array from an array, or a mapping ``{name: value}`` over zeros; as
+        in model files, a revolute, prismatic or Euler-angle coordinate's name stands for
+        its rate (``{"theta": 1}`` sets ``theta_dot``)."""
+        if isinstance(values, dict):
+            rates = {}
+            for j in self.elements[1]:
+                if j.drive is None and j.kind in ("revolute", "prismatic", "euler"):
+                    rates.update(zip(j.coordinates, j.speeds))
+            mapped = {}
+            for k, v in values.items():
+                target = k if k in self._speed_index else rates.get(k, k)
+                if target in mapped:
+                    raise ModelError(f"speed {target!r} is given twice ({k!r} stands for it); "
+                                     "keep one of the two")
+                mapped[target] = v
+            values = mapped
         return self._vector(values, np.zeros(self.nu), self._speed_index, "speed")
 
     def _vector(self, values, default, index, what):
@@ -396,12 +426,57 @@ class Model:
             self._qfull[kq] = drive.position(t)
             self._ufull[ku] = drive.velocity(t)
             self._udfull[ku] = drive.acceleration(t)
+        if self._laws:
+            self._fill_laws(q, u, t)
         for name, row, fn in self._load_functions:
             val = np.asarray(fn(t, q, u), dtype=float).reshape(-1)
             if val.shape != (3,):
                 raise ModelError(f"load {name!r}: its function returned {val.size} values at "
                                  f"t={t}; it must return three")
             row[:] = val
+
+    def _fill_laws(self, q, u, t):
+        """Each force law's value at the state: ``law(x, x')`` of a spring-damper's
+        elongation or a joint's coordinate offset, written where the kernel reads it."""
+        self._qfull[self._free_q] = q
+        self._ufull[self._free_u] = u
+        kinematics_done = False
+        fd = self._force_data
+        for el, slot, law in self._laws:
+            p = el.params
+            if el.kind == "joint-spring-damper":
+                j = self._joint[p["joint"]]
+                i = self._frame_index[j.child]
+                x = self._qfull[self._qoff[i]] - p["rest"]
+                v = self._ufull[self._uoff[i]]
+            else:
+                if not kinematics_done:
+                    from .kernels.kinematics import forward_kinematics
+                    forward_kinematics(*self._tree, self._qfull, self._ufull, self._udfull,
+                                       *self._kin_out[:8])
+                    kinematics_done = True
+                ends = []
+                for frame, point in zip(el.frames, (p["point_a"], p["point_b"])):
+                    if frame == "ground":
+                        ends.append((point, np.zeros(3)))
+                    else:
+                        i = self._frame_index[frame]
+                        lever = self._R[i] @ point
+                        ends.append((self._r[i] + lever, self._v[i] + np.cross(self._w[i], lever)))
+                d = ends[1][0] - ends[0][0]
+                L = float(np.sqrt(d @ d))
+                e = d / np.sqrt(L * L + p["min_length"] ** 2)
+                x = L - p["free_length"]
+                v = float(e @ (ends[1][1] - ends[0][1]))
+            try:
+                value = float(law(x, v))
+            except Exception as exc:
+                raise ModelError(f"force {el.name!r}: its law failed at x={x:.6g}, v={v:.6g} "
+                                 f"(t={t:.6g}): {type(exc).__name__}: {exc}") from None
+            if not np.isfinite(value):
+                raise NonFiniteError(f"model {self.name!r}, t={t:.6g}: the law of force "
+                                     f"{el.name!r} gave {value} at x={x:.6g}, v={v:.6g}")
+            fd[slot] = value
 
     def _check_finite(self, q, u, t, out, what, names=None):
         if np.all(np.isfinite(out)):
@@ -433,8 +508,15 @@ class Model:
                                 *self._kin_out)
         return q, u
 
+    def _drop_velocity_products(self):
+        """With the gyroscopic effect off: bias accelerations without velocity products."""
+        if not self.gyroscopic:
+            ke.drop_velocity_products(*self._tree, self._qfull, self._ufull, self._udfull,
+                                      *self._kin_out[:8])
+
     def _jourdain_terms(self, q, u, t):
         q, u = self._kinematics_kernel(q, u, t)
+        self._drop_velocity_products()
         kd.jourdain(self._mass, self._com, self._inertia, self._has_inertia, self._R, self._r,
                     self._w, self._alpha, self._a, self._JR, self._JT, self._anc_ptr,
                     self._anc_idx, self._parent, self._F, self._N, self._M, self._f)
@@ -592,6 +674,7 @@ class Model:
         elif method == "jourdain":
             ud = self.forward_dynamics(q, u, t)
             self._kinematics_kernel(q, u, t, ud)
+            self._drop_velocity_products()
             w = np.empty((self.n_frames, 6))
             kd.joint_wrenches(self._mass, self._com, self._inertia, self._parent, self._R,
                               self._r, self._w, self._alpha, self._a, self._F, self._N, w)
@@ -633,6 +716,43 @@ class Model:
                            self._r, self._w, self._v)
         return float(T), float(V)
 
+    def element_energy(self, q, u, t=0.0):
+        """Force elements' ``(potential energy, non-conservative power)``: the energy stored
+        in springs and contacts, and the power dampers, friction, bushings and bearings
+        deliver to the system (negative when they take energy out)."""
+        if not self.forces:
+            return 0.0, 0.0
+        self._kinematics_kernel(q, u, t)
+        acc = np.zeros(2)
+        kf.force_elements(self._force_int, self._force_data, self._parent, self._axis,
+                          self._com, self._qfull, self._ufull, self._R, self._r, self._w,
+                          self._v, self._F, self._N, acc)
+        return float(acc[0]), float(acc[1])
+
+    def load_power(self, q, u, t=0.0):
+        """Power of the loads (``add_load``) on the system: force times the velocity of its
+        point plus moment times the body's angular velocity."""
+        if not self.loads:
+            return 0.0
+        self._kinematics_kernel(q, u, t)
+        P = 0.0
+        for k in range(len(self.loads)):
+            i = self._load_body[k]
+            f, m = self._load_force[k], self._load_moment[k]
+            if self._load_in_body[k]:
+                f, m = self._R[i] @ f, self._R[i] @ m
+            lever = self._R[i] @ self._load_point[k]
+            P += f @ (self._v[i] + np.cross(self._w[i], lever)) + m @ self._w[i]
+        return float(P)
+
+    def force_element(self, name):
+        """The force-element record (kind, frames, parameters) by name."""
+        for el in self._force_elements:
+            if el.name == name:
+                return el
+        raise ModelError(f"unknown force element {name!r}; the model's force elements are "
+                         f"{', '.join(self.forces) or '(none)'}")
+
     def point_positions(self, q, points, t=0.0):
         """World positions of points fixed on frames: ``points`` is a list of
         ``(frame, offset in the frame's components)``; returns an array (len(points), 3)."""
@@ -647,7 +767,7 @@ class Model:
     @property
     def has_callable_loads(self):
         """True when some load is a Python function (compiled loops cannot call it)."""
-        return bool(self._load_functions)
+        return bool(self._load_functions or self._laws)
 
     def drive_values(self, times):
         """``(len(times), n_drives, 3)``: each drive's ``q, q', q''`` at ``times``."""

@@ -140,13 +140,65 @@ class Body:
     com: np.ndarray = field(default_factory=lambda: np.zeros(3))
     inertia: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
     symbolic: dict = field(default_factory=dict)
+    shape: dict | None = None       # how pictures draw it (see make_shape)
 
     @property
     def has_inertia(self):
         return self.mass > 0.0 or bool(np.any(self.inertia != 0.0))
 
 
-def make_body(name, mass=0.0, com=(0, 0, 0), inertia=None, parameters=None):
+SHAPES = {"sphere": ("radius",), "box": ("size",), "cylinder": ("radius", "length"),
+          "disk": ("radius", "length"), "rod": ("start", "end")}
+
+
+def make_shape(shape, element, parameters=None):
+    """A validated drawing shape in body axes: ``{"type": "sphere", "radius": r}``,
+    ``{"type": "box", "size": [a, b, c]}``, ``{"type": "cylinder"|"disk", "radius": r,
+    "length": l, "axis": "z"}``, ``{"type": "rod", "start": [...], "end": [...]}``; each
+    with optional ``center`` (default the origin; a rod has none), ``radius`` of a rod
+    (its thickness) and ``color`` (a matplotlib/CSS colour name or "#rrggbb")."""
+    if shape is None:
+        return None
+    if not isinstance(shape, dict) or "type" not in shape:
+        raise ModelError(f"{element}: shape must be a table with a type, e.g. "
+                         "{type = \"sphere\", radius = 0.02}")
+    kind = shape["type"]
+    if kind not in SHAPES:
+        raise ModelError(f"{element}: shape type {kind!r} is not one of "
+                         f"{', '.join(SHAPES)}")
+    known = set(SHAPES[kind]) | {"type", "center", "color", "axis", "radius"}
+    extra = sorted(set(shape) - known)
+    if extra:
+        raise ModelError(f"{element}: unknown shape key(s) {', '.join(extra)} for a {kind}; "
+                         f"known: {', '.join(sorted(known))}")
+    missing = [k for k in SHAPES[kind] if k not in shape]
+    if missing:
+        raise ModelError(f"{element}: a {kind} shape needs {', '.join(missing)}")
+    out = {"type": kind, "color": str(shape.get("color", "") or "")}
+    p = parameters or {}
+    for key in ("radius", "length"):
+        if key in shape:
+            v = numeric(shape[key], p, element, f"shape {key}")
+            try:
+                v = float(v)
+            except (TypeError, ValueError):
+                raise ModelError(f"{element}: shape {key} must be a number") from None
+            if not (math.isfinite(v) and v > 0):
+                raise ModelError(f"{element}: shape {key} must be positive, got {v!r}")
+            out[key] = v
+    for key in ("center", "start", "end", "size"):
+        if key in shape:
+            out[key] = _vector3(numeric(shape[key], p, element, f"shape {key}"),
+                                f"shape {key}", element)
+    if kind == "box" and np.any(out["size"] <= 0):
+        raise ModelError(f"{element}: box size must be three positive lengths")
+    out.setdefault("center", np.zeros(3))
+    if kind in ("cylinder", "disk"):
+        out["axis"] = parse_axis(shape.get("axis", "z"), element)
+    return out
+
+
+def make_body(name, mass=0.0, com=(0, 0, 0), inertia=None, parameters=None, shape=None):
     """Validate and build a ``Body``; see ``System.add_body``.
 
     Values may be sympy expressions of ``parameters`` (``{name: value}``); the record keeps
@@ -167,7 +219,7 @@ def make_body(name, mass=0.0, com=(0, 0, 0), inertia=None, parameters=None):
         raise ModelError(f"{element}: mass must be finite and >= 0, got {mass!r}")
     com = _vector3(com, "com", element)
     inertia = inertia_tensor(inertia, element)
-    return Body(name, mass, com, inertia, symbolic)
+    return Body(name, mass, com, inertia, symbolic, make_shape(shape, element, parameters))
 
 
 def inertia_tensor(inertia, element):

@@ -13,9 +13,11 @@ import numpy as np
 import sympy
 
 from .compile import Model
+from .effects import parse_effects, warn_if_unphysical
 from .elements import (has_symbols, inertia_tensor, make_body, make_joint, make_load,
                        numeric)
 from .errors import ModelError, ModelWarning, SingularMassMatrixError
+from .forces import GLOBAL_EFFECTS, make_force
 
 GROUND = "ground"
 
@@ -53,6 +55,7 @@ class System:
         self.graph.add_node(GROUND, body=make_body(GROUND))
         self._joints = {}
         self._loads = {}
+        self._forces = {}
 
     # ------------------------------------------------------------------ building
     def symbols(self, names):
@@ -73,18 +76,21 @@ class System:
             raise ModelError(f"body/frame {name!r}: the name is already used by {what}; "
                              "choose another name")
 
-    def add_body(self, name, mass=0.0, com=(0, 0, 0), inertia=None):
+    def add_body(self, name, mass=0.0, com=(0, 0, 0), inertia=None, shape=None):
         """A rigid body: ``mass``, centre of mass ``com`` in body components (from the
         frame origin), ``inertia`` about the centre of mass in body axes -- ``None``/0 for a
-        particle, three principal moments, or a 3x3 tensor (see ``mbdyn.inertia``)."""
+        particle, three principal moments, or a 3x3 tensor (see ``mbdyn.inertia``).
+        ``shape``: how pictures draw it (``mbdyn.elements.make_shape``)."""
         self._check_new_frame(name)
-        self.graph.add_node(name, body=make_body(name, mass, com, inertia, self.parameters))
+        self.graph.add_node(name, body=make_body(name, mass, com, inertia, self.parameters,
+                                                 shape))
         return name
 
-    def add_frame(self, name):
-        """A massless frame (e.g. a gimbal ring or an intermediate joint frame)."""
+    def add_frame(self, name, shape=None):
+        """A massless frame (e.g. a gimbal ring or an intermediate joint frame); ``shape``
+        draws it (an arm, a disk)."""
         self._check_new_frame(name)
-        self.graph.add_node(name, body=make_body(name))
+        self.graph.add_node(name, body=make_body(name, shape=shape))
         return name
 
     def add_joint(self, name, kind, parent, child, *, axis=None, position=(0, 0, 0),
@@ -142,14 +148,50 @@ class System:
         numbers (``q``, ``u`` arrays in ``Model.coordinates``/``Model.speeds`` order);
         ``frame``: ``"world"`` or ``"body"`` components.
         """
-        if name in self._loads:
-            raise ModelError(f"load {name!r}: the name is already used by another load")
+        if name in self._loads or name in self._forces or name in GLOBAL_EFFECTS:
+            raise ModelError(f"load {name!r}: the name is already used by another load, a "
+                             "force element or an effect; loads and force elements share "
+                             "one namespace (their names are the scene's effects)")
         if body not in self.graph or body == GROUND:
             raise ModelError(f"load {name!r}: unknown body {body!r}; loads act on bodies "
                              f"and frames added with add_body or add_frame (known: "
                              f"{', '.join(n for n in self.graph if n != GROUND)})")
         self._loads[name] = make_load(name, body, force, moment, point, frame, self.parameters)
         return name
+
+    def add_force(self, name, kind, **params):
+        """A force element (see ``mbdyn.forces`` and docs/model-files.md, "Force elements").
+
+        ``kind``: ``"spring-damper"`` (``body_a``, ``point_a``, ``body_b`` (default the
+        ground), ``point_b``, ``stiffness``, ``damping``, ``free_length``, ``preload`` or
+        ``force_table`` / ``damping_table``), ``"joint-spring-damper"`` (``joint``,
+        ``stiffness``, ``damping``, ``rest``, ``preload`` or tables), ``"bushing"``
+        (``body_a``, ``point_a``, ``body_b``, ``point_b``, 6x6 ``stiffness``, ``damping``),
+        ``"bearing"`` (shaft ``body``, ``point``, ``housing``, ``center``, ``axis``,
+        ``kxx`` ... ``cyy`` constant or tabulated against ``speeds`` of ``speed``),
+        ``"contact"`` (``body``, ``center``, ``radius``, ``shape``, ``stiffness``,
+        ``exponent``, ``restitution``, ``impact_speed``, ``friction``, ``slip_speed``,
+        ``plane_point``, ``plane_normal``).  Points are in their body's components.
+        """
+        if name in self._forces or name in self._loads:
+            raise ModelError(f"force {name!r}: the name is already used by another force "
+                             "element or load; loads and force elements share one namespace "
+                             "(their names are the scene's effects)")
+        el = make_force(name, kind, self.parameters, self.gravity, **params)
+        for frame in el.frames:
+            if frame != GROUND and frame not in self.graph:
+                raise ModelError(f"force {name!r}: unknown body {frame!r}; add it first with "
+                                 f"add_body or add_frame (known: "
+                                 f"{', '.join(n for n in self.graph if n != GROUND)}, ground)")
+        if kind == "joint-spring-damper" and el.params["joint"] not in self._joints:
+            raise ModelError(f"force {name!r}: unknown joint {el.params['joint']!r}; add it "
+                             f"first (known: {', '.join(self._joints) or 'none'})")
+        self._forces[name] = el
+        return name
+
+    def effect_names(self):
+        """Every effect of the system: ``gravity``, ``gyroscopic``, loads, force elements."""
+        return GLOBAL_EFFECTS + tuple(self._loads) + tuple(self._forces)
 
     # ------------------------------------------------------------------ inspection
     @property
@@ -164,6 +206,10 @@ class System:
     def loads(self):
         return dict(self._loads)
 
+    @property
+    def forces(self):
+        return dict(self._forces)
+
     # ------------------------------------------------------------------ compile
     def topological_frames(self):
         """Non-ground frames, parents before children (raises if any is not connected)."""
@@ -175,12 +221,17 @@ class System:
                              "'ground' or to a connected frame with add_joint")
         return [n for n in nx.topological_sort(self.graph) if n != GROUND]
 
-    def compile(self, check_inertia=True):
+    def compile(self, check_inertia=True, effects=None):
         """Validate the whole tree and return a frozen ``Model``.
 
         ``check_inertia`` evaluates the mass matrix at a few random configurations and
         refuses degrees of freedom that carry no inertia (a singular ``M``), naming them.
+        ``effects`` switches contributions on or off by name (``"-gravity,-damper"``, a list
+        of such items, or ``{"gravity": False, "off": [...]}``; see ``mbdyn.effects``):
+        the model holds only what is on, exactly as if the rest were deleted.
         """
+        state = parse_effects(effects, self.effect_names())
+        warn_if_unphysical(state, self.name)
         order = self.topological_frames()
         if not order:
             raise ModelError(f"system {self.name!r} has no bodies; add bodies and joints")
@@ -191,9 +242,13 @@ class System:
             for b in bodies:            # re-run the checks so the model carries the warnings
                 inertia_tensor(b.inertia, f"body {b.name!r}")
         found = [str(w.message) for w in caught if issubclass(w.category, ModelWarning)]
-        model = Model(self.name, bodies, joints, list(self._loads.values()), self.gravity,
+        gravity = self.gravity if state["gravity"] else np.zeros(3)
+        model = Model(self.name, bodies, joints,
+                      [ld for ld in self._loads.values() if state[ld.name]], gravity,
                       warnings=found, parameters=self.parameters,
-                      gravity_symbolic=self.gravity_symbolic)
+                      gravity_symbolic=self.gravity_symbolic if state["gravity"] else None,
+                      forces=[el for el in self._forces.values() if state[el.name]],
+                      effects=state)
         if check_inertia and model.nu:
             _check_inertia_of_every_dof(model)
         return model
@@ -218,7 +273,17 @@ def _check_inertia_of_every_dof(model, samples=3, seed=12345):
             singular_sets.append(set(exc.coordinates))
     names = sorted(set.intersection(*singular_sets), key=model.speeds.index) or \
         sorted(set.union(*singular_sets), key=model.speeds.index)
+    hint = ""
+    for j in dict.fromkeys(model._speed_joint[model._speed_index[n]] for n in names):
+        joint = model.joint(j)
+        body = model.body(joint.child)
+        if joint.kind in ("spherical", "free") and not np.any(body.inertia):
+            hint = (f"  Joint {j!r} carries a particle ({joint.child!r} has mass but no "
+                    "inertia), whose spin about its own lever carries none: use two revolute "
+                    "joints instead, or give the body a small isotropic inertia (e.g. "
+                    "inertia=[1e-9, 1e-9, 1e-9]), which leaves its translation and conical "
+                    "motion exact and only adds an unobservable spin.")
     raise ModelError(f"system {model.name!r}: the degrees of freedom {model.describe_speeds(names)} "
                      "carry no inertia -- the mass matrix is singular in every configuration.  "
                      "Give the bodies these joints move mass or inertia about the joint axes, "
-                     "or remove (fix) those joints.")
+                     "or remove (fix) those joints." + hint)

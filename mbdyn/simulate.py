@@ -11,11 +11,13 @@ from __future__ import annotations
 
 import time as _time
 import warnings
-from dataclasses import dataclass
 
 import numpy as np
 from scipy import integrate, optimize
 
+from .balance import energy_balance
+from .events import Event, EventRecord, as_event, check_conditions
+from .force_packing import warn_outside_tables
 from .errors import (ModelError, NonFiniteError, SimulationError, SingularityWarning,
                      SingularMassMatrixError)
 
@@ -26,35 +28,18 @@ INTEGRATORS = tuple(ADAPTIVE) + FIXED_STEP
 OUTPUTS = ("reactions", "energy")
 
 
-@dataclass(frozen=True)
-class Event:
-    """A zero crossing of ``condition(t, q, u)``; ``direction`` +1 (rising), -1 (falling)
-    or 0 (either); a ``terminal`` event stops the run."""
-    name: str
-    condition: object
-    terminal: bool = False
-    direction: int = 0
-
-
-def _as_event(e):
-    if isinstance(e, Event):
-        return e
-    if isinstance(e, dict):
-        return Event(**e)
-    if isinstance(e, (tuple, list)):
-        return Event(*e)
-    raise ModelError(f"event {e!r}: give an mb.Event(name, condition, terminal, direction)")
-
-
 class Result:
     """Time series of a simulation.
 
     ``t`` (n,), ``q`` (n, nq), ``u`` (n, nu); ``res["theta1"]`` gives a coordinate or speed
-    by name; ``events`` is ``[(name, t), ...]``; ``stats`` the integrator's statistics;
+    by name; ``events`` is ``[(name, t), ...]`` (``EventRecord``s: each also carries the
+    state there, ``.q``, ``.u``, ``.state``); ``stats`` the integrator's statistics;
     on request ``reactions`` ``{joint: (n, 6)}`` (force then moment, world components, at
-    the joint origin), ``energy`` ``{"kinetic", "potential", "total"}`` and ``points``
+    the joint origin), ``energy`` (see ``mbdyn.balance.energy_balance``: ``kinetic``,
+    ``potential``, ``total`` = T + V, ``dissipated``, ``work``, ``balance``) and ``points``
     ``{name: (n, 3)}``.  With energies, ``stats["energy_drift"]`` is
-    ``max |E(t) - E(0)|`` over the energy scale ``max(|E(0)|, max T, max |V|)``.
+    ``max |B(t) - B(0)|`` of the balance ``B = T + V + dissipated - work`` over the energy
+    scale (the largest of its terms).
     """
 
     def __init__(self, model, t, q, u, events, stats):
@@ -114,12 +99,13 @@ class Result:
             self.reactions = reac
             self.drive_efforts = efforts
         if "energy" in outputs:
-            TV = np.array([model.energy(self.q[k], self.u[k], self.t[k]) for k in range(n)])
-            self.energy = {"kinetic": TV[:, 0], "potential": TV[:, 1],
-                           "total": TV[:, 0] + TV[:, 1]}
-            E0 = self.energy["total"][0]
-            scale = max(abs(E0), np.abs(TV).max(), 1e-300)
-            self.stats["energy_drift"] = float(np.abs(self.energy["total"] - E0).max() / scale)
+            self.energy = energy_balance(model, self.t, self.q, self.u)
+            E = self.energy["balance"]
+            scale = max(abs(E[0]), np.abs(self.energy["kinetic"]).max(),
+                        np.abs(self.energy["potential"]).max(),
+                        np.abs(self.energy["dissipated"]).max(),
+                        np.abs(self.energy["work"]).max(), 1e-300)
+            self.stats["energy_drift"] = float(np.abs(E - E[0]).max() / scale)
         if points:
             names = list(points)
             specs = [points[p] for p in names]
@@ -250,15 +236,23 @@ class _RightHandSide:
         return out
 
 
-def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator="RK45", rtol=1e-6,
-             atol=1e-9, dt=None, method="jourdain", events=(), t_eval=None, max_step=np.inf,
+#: The defaults of every run -- Python, model files and the command line: DOP853 at
+#: rtol 1e-9, atol 1e-12 (docs/accuracy.md says why).
+DEFAULTS = {"integrator": "DOP853", "rtol": 1e-9, "atol": 1e-12, "method": "jourdain"}
+
+
+def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["integrator"],
+             rtol=DEFAULTS["rtol"], atol=DEFAULTS["atol"], dt=None, method=DEFAULTS["method"], events=(), t_eval=None, max_step=np.inf,
              outputs=(), points=None, progress=None, singularity_threshold=1e-3,
              compiled_loop=True):
     """Integrate ``model`` (a compiled ``Model``, or a ``System`` to compile) from ``t0``
     to ``t_end``.
 
     ``q0``/``u0``: arrays or ``{name: value}`` over the defaults (zero, identity
-    quaternions).  ``integrator``: one of ``INTEGRATORS``; the fixed-step ones need ``dt``.
+    quaternions); in ``u0`` a revolute, prismatic or Euler-angle coordinate's name stands
+    for its rate, as in model files.  ``integrator``: one of ``INTEGRATORS`` (default
+    ``DEFAULTS``: DOP853 at rtol 1e-9, atol 1e-12, the same as model files and the command
+    line); the fixed-step ones need ``dt``.
     ``method``: ``"jourdain"``, ``"newton-euler"`` or ``"symbolic"`` (the closed-form
     equations compiled by ``mbdyn.symbolic.compiled_rhs``).  ``events``: ``Event``s.
     ``t_eval``: output times (default every accepted step).  ``outputs``: any of ``"reactions"``,
@@ -290,7 +284,9 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator="RK45", rtol=
     if not (np.all(np.isfinite(q)) and np.all(np.isfinite(u))):
         raise ModelError("initial state must be finite")
     model.normalize_quaternions(q)
-    events = [_as_event(e) for e in events]
+    events = [as_event(e, model) for e in events]
+    if events:
+        check_conditions(events, model, t0, q, u)
     rhs = _RightHandSide(model, method)
     monitor = _Monitor(model, singularity_threshold)
     y0 = np.concatenate([q, u])
@@ -325,6 +321,8 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator="RK45", rtol=
     for row in qs:                      # report unit quaternions; the drift is in stats
         model.normalize_quaternions(row)
     result = Result(model, ts, qs, ys[:, model.nq:], found, stats)
+    if getattr(model, "_force_elements", ()):
+        warn_outside_tables(model, ts, ys[:, model.nq:])
     if failure is not None:
         stats["status"] = "failed"
         result.stats = stats
@@ -409,7 +407,9 @@ def _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events, 
             for te, e in sorted(hits, key=lambda h: h[0]):
                 if stop_at is not None:
                     break
-                found.append((e.name, te))
+                ye = dense(te)
+                found.append(EventRecord(e.name, te, ye[:model.nq], ye[model.nq:],
+                                         model.coordinates + model.speeds))
                 if e.terminal:
                     stop_at = te
             g_old = g_new
@@ -551,7 +551,10 @@ def _run_fixed(rhs, integrator, t0, t_end, y0, dt, events, t_eval, progress, mon
                         te = t + (t_new - t) * g_old[j] / (g_old[j] - g_new[j])
                         hits.append((te, e))
                 for te, e in sorted(hits, key=lambda x: x[0]):
-                    found.append((e.name, te))
+                    w = (te - t) / (t_new - t) if t_new != t else 1.0
+                    ye = (1 - w) * y + w * y_new
+                    found.append(EventRecord(e.name, te, ye[:model.nq], ye[model.nq:],
+                                             model.coordinates + model.speeds))
                     if e.terminal:
                         stop = True
                         break

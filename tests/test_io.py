@@ -119,7 +119,7 @@ def test_warnings_are_reported_once_and_kept(tmp_path):
 
 def test_cases_default_and_explicit():
     a = load_model(MODELS / "top.toml")
-    assert a.case == "a" and a.cases == ("a", "b", "c", "d")
+    assert a.case == "a" and a.cases == ("a", "b", "c", "d", "floor")
     assert a.parameters["Mz"] == -0.025
     b = load_model(MODELS / "top.toml", case="b")
     assert b.case == "b" and b.parameters["Mz"] == -0.001

@@ -418,8 +418,10 @@ def test_unknown_coordinate_names_are_refused():
     model = pendulum().compile()
     with pytest.raises(mb.ModelError, match=r"unknown coordinate 'hnige'.*hinge"):
         model.q_vector({"hnige": 0.1})
-    with pytest.raises(mb.ModelError, match=r"unknown speed 'hinge'.*hinge_dot"):
-        model.u_vector({"hinge": 0.1})
+    with pytest.raises(mb.ModelError, match=r"unknown speed 'hnige'.*hinge_dot"):
+        model.u_vector({"hnige": 0.1})
+    # a coordinate's name stands for its rate, as in model files (issue 14)
+    assert model.u_vector({"hinge": 0.1}) == pytest.approx([0.1])
 
 
 def test_unknown_coordinate_names_in_simulate_are_refused():

@@ -17,7 +17,8 @@ import os
 import sys
 import warnings
 
-COMMANDS = ["run", "info", "eom", "accuracy", "sweep"]
+COMMANDS = ["run", "info", "eom", "accuracy", "equilibrium", "modes", "campbell", "plot",
+            "animate", "sweep"]
 
 EXIT_OK, EXIT_INPUT, EXIT_USAGE, EXIT_SIMULATION, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 

@@ -19,6 +19,10 @@ def add_model_arguments(parser):
                         help="override a value by its dotted path after the case, e.g. "
                              "parameters.b=0.3, initial.beta=pi/8, bodies.disk.mass=2 "
                              "(repeatable)")
+    parser.add_argument("--effects", metavar="LIST",
+                        help="switch effects off (-name) or on (+name) after the file's "
+                             "[effects], e.g. --effects=-gravity,-bearing_left; names: gravity, "
+                             "gyroscopic, every load and force element (mbdyn info lists them)")
 
 
 def overrides(args, flags=()):
@@ -36,11 +40,14 @@ def overrides(args, flags=()):
 
 def load(args, flags=(), record_warnings=False):
     """The ``Scene`` of the command line's model, case and overrides."""
+    effects = getattr(args, "effects", None)
     if record_warnings:
         with warnings.catch_warnings(record=True):
             warnings.simplefilter("always")
-            return load_model(args.model, case=args.case, overrides=overrides(args, flags))
-    return load_model(args.model, case=args.case, overrides=overrides(args, flags))
+            return load_model(args.model, case=args.case, overrides=overrides(args, flags),
+                              effects=effects)
+    return load_model(args.model, case=args.case, overrides=overrides(args, flags),
+                      effects=effects)
 
 
 def fmt(x):

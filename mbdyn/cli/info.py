@@ -67,6 +67,10 @@ def describe(scene):
         "bodies": bodies, "joints": joints,
         "coordinates": list(model.coordinates), "speeds": list(model.speeds),
         "dof": model.nu, "drives": drives, "loads": loads,
+        "forces": [{"name": el.name, "kind": el.kind, "description": el.describe(),
+                    "on": model.effects.get(el.name, True)}
+                   for el in scene.system.forces.values()],
+        "effects": dict(model.effects),
         "events": list(scene.event_specs), "initial": scene.initial_state,
         "simulation": dict(scene.settings),
         "outputs": outputs_spec(scene),
@@ -125,6 +129,12 @@ def info(args):
     for ld in d["loads"]:
         parts = [f"{k} {_text(ld[k])}" for k in ("force", "moment") if ld[k] is not None]
         w(f"  {ld['name']:<14} on {ld['body']}: {', '.join(parts)} ({ld['frame']} axes)\n")
+    w(f"forces ({len(d['forces'])})\n")
+    for fe in d["forces"]:
+        w(f"  {fe['name']:<14} {fe['kind']}: {fe['description']}"
+          f"{'' if fe['on'] else '  [off]'}\n")
+    w("effects      " + ", ".join(f"{k} {'on' if on else 'OFF'}"
+                                  for k, on in d["effects"].items()) + "\n")
     w(f"events ({len(d['events'])})\n")
     for e in d["events"]:
         w(f"  {e['name']:<14} {e['condition']}  ({e['direction']}"

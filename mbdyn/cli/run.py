@@ -34,11 +34,16 @@ def register(subparsers):
                                                 "STEM.json (metadata) into DIR")
     p.add_argument("--json", action="store_true",
                    help="print one JSON object (the summary) and nothing else on stdout")
+    p.add_argument("--plot", metavar="FILE",
+                   help="also plot the coordinates (and energies) into FILE (.png, .pdf, .svg)")
     p.set_defaults(func=run)
 
 
 def run(args):
     scene = load(args, FLAGS)
+    if args.plot:
+        from ..viz.plots import _check_path
+        _check_path(args.plot)
     progress = Progress(scene.settings.get("t_end") or 0.0)
     try:
         result = scene.simulate(progress=progress)
@@ -53,7 +58,10 @@ def run(args):
                                   "--integrator such as DOP853)", exc.result) from exc
         raise
     progress.close()
-    paths = write_results(args.out, scene, result) if args.out else ()
+    paths = list(write_results(args.out, scene, result)) if args.out else []
+    if args.plot:
+        from .plot import plot_run
+        paths.append(plot_run(scene, result, out=args.plot))
     if args.json:
         sys.stdout.write(json.dumps(summary(scene, result)) + "\n")
     else:

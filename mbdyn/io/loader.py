@@ -25,6 +25,7 @@ from .. import compile as _compile
 from ..elements import t as TIME
 from ..errors import ModelError
 from ..model import GROUND, System
+from ..simulate import DEFAULTS as SIMULATE_DEFAULTS
 from ..simulate import FIXED_STEP, INTEGRATORS, Event, Result
 from ..simulate import simulate as _simulate
 from .errors import ModelFileError
@@ -37,8 +38,7 @@ from .schema import (DIRECTIONS, Checker, _suggest, apply_case, apply_override,
 METHODS = tuple(_compile.METHODS) + ("symbolic",)
 
 #: ``[simulation]`` defaults.
-DEFAULT_SIMULATION = {"integrator": "DOP853", "method": "jourdain", "rtol": 1e-9,
-                      "atol": 1e-12}
+DEFAULT_SIMULATION = dict(SIMULATE_DEFAULTS)     # one set of defaults (mbdyn.simulate)
 SIMULATE_KEYWORDS = ("t_end", "integrator", "method", "rtol", "atol", "dt", "max_step",
                      "output_dt", "progress", "events", "outputs", "points")
 
@@ -94,14 +94,16 @@ def _normalise_overrides(overrides):
     return out
 
 
-def load_model(path, case=None, overrides=None):
+def load_model(path, case=None, overrides=None, effects=None):
     """Read a model file and return a ready-to-run ``Scene``.
 
     ``case``: the name of a ``[cases.NAME]`` table to apply (default: the file's
     ``model.default_case``, if any).  ``overrides``: ``{"parameters.Mz": -0.01, ...}``
     (values: numbers, booleans, arrays, or strings holding expressions or names) or an
     iterable of ``"PATH=VALUE"`` texts as ``mbdyn run --set`` takes them; applied after
-    the case.  Raises ``ModelFileError`` (a ``ModelError``) naming file and key.
+    the case.  ``effects``: switches applied after the file's ``[effects]``, as
+    ``--effects`` takes them (``"-gravity,-damper"``, a list, or a mapping; see
+    ``mbdyn.effects``).  Raises ``ModelFileError`` (a ``ModelError``) naming file and key.
     """
     doc = read_document(path)
     checker = Checker(path)
@@ -120,9 +122,11 @@ def load_model(path, case=None, overrides=None):
     for path_text, value, origin in _normalise_overrides(overrides):
         apply_override(merged, path_text, value, checker, origin)
     checker.check_document(merged)
-    builder = _SceneBuilder(path, merged, checker)
+    builder = _SceneBuilder(path, merged, checker, effects)
     scene = builder.build()
     scene.case = chosen
+    scene.overrides = list(_normalise_overrides(overrides))
+    scene.effects_spec = effects
     scene.cases = tuple(cases)
     scene.default_case = default_case
     for message, category in builder.emitted:
@@ -166,6 +170,14 @@ class Scene:
     def __repr__(self):
         case = f", case {self.case!r}" if self.case else ""
         return f"<Scene {self.name!r} from {self.path}{case}: {self.model!r}>"
+
+    def rebuild(self, overrides=None):
+        """The same file, case, overrides and effects, with further ``overrides``
+        (``{"parameters.Omega": 300}``) applied last: a new ``Scene``."""
+        return load_model(self.path, case=self.case,
+                          overrides=list(getattr(self, "overrides", [])) +
+                          _normalise_overrides(overrides),
+                          effects=getattr(self, "effects_spec", None))
 
     @property
     def initial_state(self):
@@ -237,7 +249,8 @@ def _thin(result, every):
 class _SceneBuilder:
     """Builds System, Model and Scene from a merged, shape-checked document."""
 
-    def __init__(self, path, doc, checker):
+    def __init__(self, path, doc, checker, effects=None):
+        self.effects_override = effects
         self.path = path
         self.file = str(path)
         self.doc = doc
@@ -324,8 +337,10 @@ class _SceneBuilder:
             self.PTQ = dict(self.PT)
             self.PTQ.update(self.names_q)
             self.loads()
+            self.forces()
+            effects = self.effects()
             with self.engine(()):
-                model = system.compile()
+                model = system.compile(effects=effects)
             self.model = model
             q0, u0, initial = self.initial()
             settings = self.simulation()
@@ -346,7 +361,7 @@ class _SceneBuilder:
                      events=events, event_specs=event_specs,
                      warnings=tuple(m for m, _ in messages), document=doc,
                      joint_specs=self.joint_specs, load_specs=self.load_specs,
-                     body_specs=self.body_specs)
+                     body_specs=self.body_specs, force_specs=self.force_specs)
 
     def parameters(self):
         raw = self.doc.get("parameters", {})
@@ -398,8 +413,19 @@ class _SceneBuilder:
                     raise self.error(path + ("inertia_about",), "\"origin\" needs an inertia "
                                      "to convert; give inertia = [...] or remove inertia_about")
                 inertia = _inertia_about_com(inertia, mass, com)
+            shape = None
+            if "shape" in b:
+                shape = dict(b["shape"])
+                for key in ("radius", "length"):
+                    if key in shape:
+                        shape[key] = self.number(shape[key], path + ("shape", key),
+                                                 positive=True)
+                for key in ("center", "start", "end", "size"):
+                    if key in shape:
+                        shape[key] = [self.number(v, path + ("shape", key, k))
+                                      for k, v in enumerate(shape[key])]
             with self.engine(path):
-                self.system.add_body(name, mass=mass, com=com, inertia=inertia)
+                self.system.add_body(name, mass=mass, com=com, inertia=inertia, shape=shape)
             self.body_specs.append(dict(b))
 
     def joints(self):
@@ -483,6 +509,61 @@ class _SceneBuilder:
                                      point=self.pvector(ld.get("point"), path + ("point",)),
                                      frame=ld.get("frame", "world"))
             self.load_specs.append(dict(ld))
+
+    def forces(self):
+        """``[[forces]]``: each table's keys handed to ``System.add_force``."""
+        self.force_specs = []
+        for i, fe in enumerate(self.doc.get("forces", [])):
+            path = ("forces", i)
+            name = self.required(fe, "name", path, "force element")
+            kind = self.required(fe, "kind", path, "force element")
+            kw = {}
+            for key, value in fe.items():
+                if key in ("name", "kind"):
+                    continue
+                kpath = path + (key,)
+                if key in ("body_a", "body_b", "body", "housing", "joint", "speed", "shape",
+                           "interpolation"):
+                    kw[key] = value
+                elif key in ("point_a", "point_b", "point", "center", "plane_point"):
+                    kw[key] = self.pvector(value, kpath)
+                elif key in ("axis", "plane_normal"):
+                    kw[key] = value if isinstance(value, str) else self.pvector(value, kpath)
+                elif key == "law":
+                    for n in ("x", "v"):
+                        if n in self.P:
+                            raise self.error(kpath, f"a law's variables are x (elongation) and "
+                                             f"v (its rate), but {n!r} is also a parameter; "
+                                             "rename the parameter")
+                    kw[key] = self.expr(value, kpath, dict(self.P, x=symbol("x"),
+                                                          v=symbol("v")))
+                elif key in ("force_table", "damping_table"):
+                    kw[key] = [[self.number(x, kpath + (r, 0)), self.number(y, kpath + (r, 1))]
+                               for r, (x, y) in enumerate(value)]
+                elif isinstance(value, list):
+                    if value and all(isinstance(r, list) for r in value):
+                        kw[key] = [[self.number(v, kpath + (r, c)) for c, v in enumerate(row)]
+                                   for r, row in enumerate(value)]
+                    else:
+                        kw[key] = [self.number(v, kpath + (k,)) for k, v in enumerate(value)]
+                else:
+                    kw[key] = self.pval(value, kpath)
+            with self.engine(path):
+                self.system.add_force(name, kind, **kw)
+            self.force_specs.append(dict(fe))
+
+    def effects(self):
+        """The file's ``[effects]`` then the caller's switches, checked by name."""
+        from ..effects import parse_effects
+        known = self.system.effect_names()
+        with self.engine(("effects",)):
+            state = parse_effects(self.doc.get("effects"), known, f"{self.file}: effects")
+        if self.effects_override is not None:
+            try:
+                state = parse_effects(self.effects_override, known, "--effects", base=state)
+            except ModelError as exc:
+                raise ModelFileError("--effects", "", str(exc)) from None
+        return state
 
     def initial(self):
         model = self.model

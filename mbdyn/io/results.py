@@ -86,9 +86,10 @@ def columns(scene, result):
     names = ["t"] + list(result.coordinates) + list(result.speeds)
     cols = [result.t[:, None], result.q, result.u]
     if result.energy is not None:
-        for key in ("kinetic", "potential", "total"):
-            names.append(f"energy_{key}")
-            cols.append(np.asarray(result.energy[key])[:, None])
+        for key in ("kinetic", "potential", "total", "dissipated", "work", "balance"):
+            if key in result.energy:
+                names.append(f"energy_{key}")
+                cols.append(np.asarray(result.energy[key])[:, None])
     for j, arr in reaction_series(scene, result).items():
         names.extend(f"reaction_{j}_{c}" for c in WRENCH)
         cols.append(arr)

@@ -23,7 +23,10 @@ from .expressions import RESERVED, ExpressionError, parse, parse_condition
 MODEL_KEYS = {"name": "string", "description": "string", "gravity": "vector",
               "default_case": "string"}
 BODY_KEYS = {"name": "name", "mass": "expr", "com": "vector", "inertia": "inertia",
-             "inertia_about": ("choice", ("com", "origin"))}
+             "inertia_about": ("choice", ("com", "origin")), "shape": "shape"}
+SHAPE_KEYS = {"type": ("choice", ("sphere", "box", "cylinder", "disk", "rod")),
+              "radius": "expr", "length": "expr", "size": "vector", "center": "vector",
+              "start": "vector", "end": "vector", "axis": "axis", "color": "string"}
 JOINT_KINDS = ("revolute", "prismatic", "euler", "spherical", "fixed", "free")
 JOINT_KEYS = {"name": "name", "kind": ("choice", JOINT_KINDS), "parent": "name",
               "child": "name", "axis": "axis", "position": "vector",
@@ -37,6 +40,23 @@ SIMULATION_KEYS = {"t_end": "expr", "integrator": "string", "method": "string",
 OUTPUT_KEYS = {"reactions": "reactions", "reactions_frame": ("choice", ("world", "child")),
                "energy": "bool", "points": "points"}
 POINT_KEYS = {"frame": "name", "offset": "vector"}
+FORCE_KINDS = ("spring-damper", "joint-spring-damper", "bushing", "bearing", "contact")
+FORCE_KEYS = {"name": "name", "kind": ("choice", FORCE_KINDS),
+              "body_a": "name", "point_a": "vector", "body_b": "name", "point_b": "vector",
+              "body": "name", "point": "vector", "housing": "name", "center": "vector",
+              "joint": "name", "axis": "axis", "stiffness": "matrix6", "damping": "matrix6",
+              "free_length": "expr", "preload": "expr", "rest": "expr", "min_length": "expr",
+              "force_table": "table", "damping_table": "table", "law": "expr",
+              "interpolation": ("choice", ("pchip", "linear")),
+              "speed": "name", "speeds": "exprs",
+              "kxx": "coefficient", "kxy": "coefficient", "kyx": "coefficient",
+              "kyy": "coefficient", "cxx": "coefficient", "cxy": "coefficient",
+              "cyx": "coefficient", "cyy": "coefficient",
+              "radius": "expr", "shape": ("choice", ("sphere", "disk")),
+              "plane_point": "vector", "plane_normal": "axis", "exponent": "expr",
+              "restitution": "expr", "impact_speed": "expr", "friction": "expr",
+              "slip_speed": "expr"}
+EFFECT_KEYS = {"gravity": "bool", "gyroscopic": "bool", "off": "names", "on": "names"}
 EVENT_KEYS = {"name": "name", "condition": "condition", "terminal": "bool",
               "direction": "direction"}
 
@@ -48,6 +68,8 @@ SECTIONS = {
     "bodies": ("array", BODY_KEYS),
     "joints": ("array", JOINT_KEYS),
     "loads": ("array", LOAD_KEYS),
+    "forces": ("array", FORCE_KEYS),
+    "effects": ("table", EFFECT_KEYS),
     "initial": ("map", None),
     "initial_speeds": ("map", None),
     "simulation": ("table", SIMULATION_KEYS),
@@ -55,7 +77,8 @@ SECTIONS = {
     "events": ("array", EVENT_KEYS),
     "cases": ("cases", None),
 }
-ARRAY_ELEMENT = {"bodies": "body", "joints": "joint", "loads": "load", "events": "event"}
+ARRAY_ELEMENT = {"bodies": "body", "joints": "joint", "loads": "load", "forces": "force",
+                 "events": "event"}
 DIRECTIONS = {"rising": 1, "falling": -1, "either": 0}
 
 
@@ -312,6 +335,36 @@ class Checker:
                 return
             if not isinstance(value, list) or not all(isinstance(n, str) for n in value):
                 raise fail(path, "must be true, false or an array of joint names")
+        elif kind == "shape":
+            self.check_table(value, SHAPE_KEYS, path, required=("type",))
+        elif kind == "exprs":
+            if not isinstance(value, list) or not value:
+                raise fail(path, f"must be an array of numbers, got {_show(value)}")
+            for i, v in enumerate(value):
+                self.check_expr(v, path + (i,))
+        elif kind == "coefficient":
+            if isinstance(value, list):
+                self.check_value("exprs", value, path)
+            else:
+                self.check_expr(value, path)
+        elif kind == "matrix6":
+            if isinstance(value, list):
+                rows = value if all(isinstance(r, list) for r in value) else [value]
+                for i, row in enumerate(rows):
+                    if not isinstance(row, list):
+                        raise fail(path, "must be a number, six numbers or a 6x6 array")
+                    for j, v in enumerate(row):
+                        self.check_expr(v, path + ((i, j) if len(rows) > 1 else (j,)))
+            else:
+                self.check_expr(value, path)
+        elif kind == "table":
+            if not isinstance(value, list) or not all(
+                    isinstance(r, list) and len(r) == 2 for r in value):
+                raise fail(path, "must be an array of [x, y] pairs, e.g. [[0, 0], [0.01, 50], "
+                           f"[0.02, 180]], got {_show(value)}")
+            for i, (x, y) in enumerate(value):
+                self.check_expr(x, path + (i, 0))
+                self.check_expr(y, path + (i, 1))
         elif kind == "points":
             if not isinstance(value, dict):
                 raise fail(path, "must be a table of points: NAME = { frame = \"...\", offset "

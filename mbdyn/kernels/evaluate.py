@@ -8,6 +8,7 @@ import numpy as np
 from numba import njit
 
 from .dynamics import applied_loads, cholesky_solve, jourdain, newton_euler_system
+from .forces import force_elements
 from .kinematics import forward_kinematics
 
 
@@ -15,17 +16,37 @@ from .kinematics import forward_kinematics
 def kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                          mass, com, gravity, qfull, ufull, udfull,
                          load_body, load_point, load_force, load_moment, load_in_body,
+                         force_int, force_data, switches,
                          R, r, w, v, alpha, a, JR, JT, F, N):
+    """Motion of every frame, then the applied loads ``F``, ``N``: gravity, point loads
+    and force elements."""
     forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                        qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT)
     applied_loads(mass, com, gravity, R, r, load_body, load_point, load_force, load_moment,
                   load_in_body, F, N)
+    if force_int.shape[0]:
+        force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F,
+                       N, force_data[0:0])
+
+
+@njit(cache=True)
+def drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
+                           qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT):
+    """The ``gyroscopic`` effect switched off: the motion again with every speed zero, so
+    that the bias accelerations keep only the prescribed (drive) accelerations and
+    ``w x I w`` vanishes; the applied loads computed before keep the true velocities."""
+    saved = ufull.copy()
+    ufull[:] = 0.0
+    forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
+                       qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT)
+    ufull[:] = saved
 
 
 @njit(cache=True)
 def jourdain_accelerations(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                            mass, com, inertia, has_inertia, gravity, qfull, ufull, udfull,
                            load_body, load_point, load_force, load_moment, load_in_body,
+                           force_int, force_data, switches,
                            R, r, w, v, alpha, a, JR, JT, F, N, M, f, L, ud):
     """Kinematics, loads, ``M`` and ``f``, then ``ud = M^-1 f`` by Cholesky.
 
@@ -35,7 +56,10 @@ def jourdain_accelerations(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, an
     kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                          mass, com, gravity, qfull, ufull, udfull,
                          load_body, load_point, load_force, load_moment, load_in_body,
-                         R, r, w, v, alpha, a, JR, JT, F, N)
+                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, F, N)
+    if switches[0] == 0:
+        drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr,
+                               anc_idx, qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT)
     jourdain(mass, com, inertia, has_inertia, R, r, w, alpha, a, JR, JT, anc_ptr, anc_idx,
              parent, F, N, M, f)
     pivot = cholesky_solve(M, f, L, ud)
@@ -51,6 +75,7 @@ def jourdain_accelerations(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, an
 def newton_euler_solution(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                           mass, com, inertia, gravity, qfull, ufull, udfull,
                           load_body, load_point, load_force, load_moment, load_in_body,
+                          force_int, force_data, switches,
                           react_joint, react_force, react_moment,
                           R, r, w, v, alpha, a, JR, JT, F, N, A, b):
     """Kinematics, loads, the Newton-Euler system with reactions, solved by LU.
@@ -60,7 +85,10 @@ def newton_euler_solution(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc
     kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                          mass, com, gravity, qfull, ufull, udfull,
                          load_body, load_point, load_force, load_moment, load_in_body,
-                         R, r, w, v, alpha, a, JR, JT, F, N)
+                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, F, N)
+    if switches[0] == 0:
+        drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr,
+                               anc_idx, qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT)
     newton_euler_system(mass, com, inertia, parent, R, r, w, alpha, a, JR, JT, anc_ptr, anc_idx,
                         F, N, react_joint, react_force, react_moment, A, b)
     return np.linalg.solve(A, b)

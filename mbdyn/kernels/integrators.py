@@ -41,7 +41,8 @@ def _rhs(y, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body,
     nfev[0] += 1
     (parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx) = tree
     (mass, com, inertia, has_inertia, gravity) = body
-    (load_body, load_point, load_force, load_moment, load_in_body) = loads
+    (load_body, load_point, load_force, load_moment, load_in_body, force_int, force_data,
+     switches) = loads
     (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, F, N, M, f, L) = ws
     nu = y.shape[0] - nq
     for k in range(nq):
@@ -57,7 +58,8 @@ def _rhs(y, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body,
     pivot = jourdain_accelerations(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr,
                                    anc_idx, mass, com, inertia, has_inertia, gravity, qfull,
                                    ufull, udfull, load_body, load_point, load_force, load_moment,
-                                   load_in_body, R, r, w, v, alpha, a, JR, JT, F, N, M, f, L, ud)
+                                   load_in_body, force_int, force_data, switches,
+                                   R, r, w, v, alpha, a, JR, JT, F, N, M, f, L, ud)
     if pivot >= 0:
         return 2
     _rates(y, nq, slots, ydot)

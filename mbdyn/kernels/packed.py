@@ -16,25 +16,28 @@ import numpy as np
 from numba import njit
 
 from .evaluate import jourdain_accelerations, newton_euler_solution
+from .forces import ROW
 from .joints import coordinate_rates
 
 #: float arrays in buffer order, with their shapes in terms of the sizes below
 FLOATS = ("gravity", "axis", "pos", "C", "mass", "com", "inertia", "load_point", "load_force",
           "load_moment", "react_force", "react_moment", "qfull", "ufull", "udfull", "R", "r",
-          "w", "v", "alpha", "a", "JR", "JT", "F", "N", "M", "f", "L", "A", "b", "ud")
+          "w", "v", "alpha", "a", "JR", "JT", "F", "N", "M", "f", "L", "A", "b", "ud",
+          "force_data")
 #: integer arrays in buffer order (the two flag arrays are stored as 0/1)
 INTS = ("parent", "kind", "seq", "qoff", "uoff", "ucol", "anc_ptr", "anc_idx", "has_inertia",
-        "load_body", "load_in_body", "react_joint", "free_q", "free_u", "slots")
+        "load_body", "load_in_body", "react_joint", "free_q", "free_u", "slots", "force_int",
+        "switches")
 #: sizes, first entries of the offset table: frames, free speeds, loads, joint-space
 #: coordinates and speeds, ancestor-column entries, reaction components, free coordinates,
-#: free joints
-SIZES = ("n", "nu", "nl", "nqf", "nuf", "nanc", "nreact", "nq", "nslots")
+#: free joints, force elements, force-element numbers
+SIZES = ("n", "nu", "nl", "nqf", "nuf", "nanc", "nreact", "nq", "nslots", "ne", "nfd")
 
 (GRAVITY, AXIS, POS, C, MASS, COM, INERTIA, LOAD_POINT, LOAD_FORCE, LOAD_MOMENT, REACT_FORCE,
  REACT_MOMENT, QFULL, UFULL, UDFULL, R, RR, W, V, ALPHA, A, JR, JT, F, N, M, FF, L, AA, B,
- UD) = range(len(SIZES), len(SIZES) + len(FLOATS))
+ UD, FORCE_DATA) = range(len(SIZES), len(SIZES) + len(FLOATS))
 (PARENT, KIND, SEQ, QOFF, UOFF, UCOL, ANC_PTR, ANC_IDX, HAS_INERTIA, LOAD_BODY, LOAD_IN_BODY,
- REACT_JOINT, FREE_Q, FREE_U, SLOTS) = range(len(SIZES) + len(FLOATS), len(SIZES) + len(FLOATS) + len(INTS))
+ REACT_JOINT, FREE_Q, FREE_U, SLOTS, FORCE_INT, SWITCHES) = range(len(SIZES) + len(FLOATS), len(SIZES) + len(FLOATS) + len(INTS))
 
 
 def pack(floats, ints):
@@ -45,7 +48,8 @@ def pack(floats, ints):
              "nl": floats["load_force"].shape[0], "nqf": floats["qfull"].shape[0],
              "nuf": floats["ufull"].shape[0], "nanc": ints["anc_idx"].shape[0],
              "nreact": ints["react_joint"].shape[0], "nq": ints["free_q"].shape[0],
-             "nslots": ints["slots"].shape[0]}
+             "nslots": ints["slots"].shape[0], "ne": ints["force_int"].shape[0],
+             "nfd": floats["force_data"].shape[0]}
     table = np.zeros(len(SIZES) + len(FLOATS) + len(INTS), np.int64)
     table[:len(SIZES)] = [sizes[s] for s in SIZES]
     views = {}
@@ -72,7 +76,7 @@ def pack(floats, ints):
 def _views(fb, ib, t):
     """Every packed array as a view, in the order of the unpacked kernels' arguments:
     tree (11), body (mass, com, inertia, has_inertia, gravity), joint-space state (3),
-    loads (5), reactions (3), motion (10), Jourdain (M, f, L, ud), Newton-Euler (A, b).
+    loads (5, then force elements and effect switches: 3), reactions (3), motion (10), Jourdain (M, f, L, ud), Newton-Euler (A, b).
     Offsets are read from ``t`` at run time: literal constants as arguments would make
     numba compile a slicing helper per constant."""
     n, nu, nl, nqf, nuf, nanc, nreact = t[0], t[1], t[2], t[3], t[4], t[5], t[6]
@@ -92,7 +96,9 @@ def _views(fb, ib, t):
              fb[t[LOAD_POINT]:t[LOAD_POINT] + 3 * nl].reshape((nl, 3)),
              fb[t[LOAD_FORCE]:t[LOAD_FORCE] + 3 * nl].reshape((nl, 3)),
              fb[t[LOAD_MOMENT]:t[LOAD_MOMENT] + 3 * nl].reshape((nl, 3)),
-             ib[t[LOAD_IN_BODY]:t[LOAD_IN_BODY] + nl] != 0)
+             ib[t[LOAD_IN_BODY]:t[LOAD_IN_BODY] + nl] != 0,
+             ib[t[FORCE_INT]:t[FORCE_INT] + ROW * t[9]].reshape((t[9], ROW)),
+             fb[t[FORCE_DATA]:t[FORCE_DATA] + t[10]], ib[t[SWITCHES]:t[SWITCHES] + 1])
     reactions = (ib[t[REACT_JOINT]:t[REACT_JOINT] + nreact],
                  fb[t[REACT_FORCE]:t[REACT_FORCE] + 3 * nreact].reshape((nreact, 3)),
                  fb[t[REACT_MOMENT]:t[REACT_MOMENT] + 3 * nreact].reshape((nreact, 3)))

@@ -68,7 +68,7 @@ def jourdain(walk):
     f = [sympy.Integer(0)] * nu
     per_body = []
     for m in walk.motions:
-        if not m.has_inertia:
+        if not m.has_inertia and not m.loads:    # a massless frame adds only its loads
             continue
         I = m.inertia_basis
         aG0 = walk.bias(m.a_G)

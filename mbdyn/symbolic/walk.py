@@ -205,6 +205,7 @@ class Walk:
             if joint.parent in self.by_name:
                 self.by_name[joint.parent].children.append(m)
         self._apply_loads()
+        self._apply_forces()
 
     # ------------------------------------------------------------------ helpers
     def s(self, expr):
@@ -396,6 +397,195 @@ class Walk:
             m.loads.append((load.name, F, N, point))
             m.force = self.s(m.force + F)
             m.moment = self.s(m.moment + N + cross(lever, F))
+
+    # ------------------------------------------------------------------ force elements
+    def _param(self, el, key):
+        value = el.symbolic.get(key, el.params[key])
+        if isinstance(value, sympy.Basic):
+            return canonical(value, self.sym.table)
+        return exact(value)
+
+    def _world_point(self, frame, point):
+        """World position of a point fixed on ``frame`` (own components)."""
+        if frame == "ground":
+            return point
+        m = self.by_name[frame]
+        if self.frames == "own":
+            return self.s(self.absolute_T(frame).T * (m.r + point))
+        return self.s(m.r + m.X_child * point)
+
+    def _add_wrench(self, name, frame, F_world, N_world, point):
+        """Element ``name``'s force (world components) at ``point`` (own components) and
+        moment on ``frame``, into its applied loads."""
+        if frame == "ground":
+            return
+        m = self.by_name[frame]
+        F = self.to_basis(m, F_world, False)
+        N = self.to_basis(m, N_world, False)
+        m.loads.append((name, F, N, point))
+        lever = point - m.com if m.X_child is E3 else m.X_child * (point - m.com)
+        m.force = self.s(m.force + F)
+        m.moment = self.s(m.moment + N + cross(lever, F))
+
+    def _R_world(self, frame):
+        """Rotation matrix (own -> world components) of a frame; the identity for ground."""
+        if frame == "ground":
+            return E3
+        if self.frames == "own":
+            return self.absolute_T(frame).T
+        return self.by_name[frame].X_child
+
+    def _omega_world(self, frame):
+        if frame == "ground":
+            return Z3
+        m = self.by_name[frame]
+        return self.s(self.absolute_T(frame).T * m.omega) if self.frames == "own" else m.omega
+
+    def _own_point(self, frame, p_world):
+        """Own components (from the frame origin) of a world point."""
+        if frame == "ground":
+            return p_world
+        return self.s(self._R_world(frame).T * (p_world - self._world_point(frame, Z3)))
+
+    def _spin(self, name):
+        """The speed a bearing's coefficients depend on: a speed symbol, or a driven joint's
+        prescribed rate."""
+        for j in self.joints:
+            qj, uj, _, driven = self.joint_values[j.name]
+            if j.nu == 1 and (name == j.name or name in j.coordinates or name in j.speeds):
+                return uj[0]
+        raise ModelError(f"unknown spin speed {name!r}")
+
+    def _coefficient(self, el, key):
+        """A bearing coefficient: a number, or a table as a named function of the spin speed
+        (``kxx_bearing(spin)``) that evaluates by the table's interpolation."""
+        value = el.params[key]
+        if hasattr(value, "block"):                     # a Table
+            from sympy.utilities.lambdify import implemented_function
+            fn = implemented_function(f"{key}_{el.name}", value)
+            return fn(self._spin(el.params["speed"]))
+        return self._param(el, key)
+
+    def _apply_forces(self):
+        """Force elements as body wrenches, in closed form: a spring-damper's tension along
+        the line of its points, a joint spring-damper's effort on its coordinate, a bushing's
+        6x6 law, a bearing's eight coefficients (tabulated ones as named functions of the
+        spin speed), a contact's Hunt-Crossley force and regularised friction."""
+        for el in getattr(self.model, "_force_elements", ()):
+            p = el.params
+            tabulated = [k for k in ("force_table", "damping_table") if p.get(k) is not None]
+            if tabulated:
+                raise ModelError(f"force {el.name!r}: the symbolic layer writes linear springs "
+                                 "and dampers in closed form, not tabulated laws; switch it off "
+                                 f"to derive the rest (--effects=-{el.name})")
+            vec = lambda key: exact_vector(el.symbolic.get(key, p[key]), self.sym.table)  # noqa
+            law = p.get("law")
+            if law is not None and law.expression is None:
+                raise ModelError(f"force {el.name!r}: its law is a Python function; the symbolic "
+                                 "layer needs it as an expression of x and v (or switch it off: "
+                                 f"--effects=-{el.name})")
+            if el.kind == "spring-damper":
+                k, c, F0 = (self._param(el, key) for key in ("stiffness", "damping", "preload"))
+                pa, pb = vec("point_a"), vec("point_b")
+                a, b = el.frames
+                d = self._world_point(b, pb) - self._world_point(a, pa)
+                L = sympy.sqrt((d.T * d)[0])
+                x = L - self._param(el, "free_length")
+                T = (self._law(law, x, self.D(L)) if law is not None
+                     else F0 + k * x + c * self.D(L))
+                f = d * (T / L)
+                self._add_wrench(el.name, a, f, Z3, pa)
+                self._add_wrench(el.name, b, -f, Z3, pb)
+            elif el.kind == "joint-spring-damper":
+                k, c, F0 = (self._param(el, key) for key in ("stiffness", "damping", "preload"))
+                joint = next(j for j in self.joints if j.name == p["joint"])
+                qj, uj, _, driven = self.joint_values[joint.name]
+                x = qj[0] - self._param(el, "rest")
+                tau = -(self._law(law, x, uj[0]) if law is not None else F0 + k * x + c * uj[0])
+                m = self.by_name[joint.child]
+                axis = self._joint_geometry(joint)[0]
+                # the axis in world components: joint frame J0 = child axes along the axis
+                axis_w = self.s(self._R_world(joint.child) * axis)
+                if joint.kind == "revolute":
+                    self._add_wrench(el.name, joint.child, Z3, tau * axis_w, Z3)
+                    self._add_wrench(el.name, joint.parent, Z3, -tau * axis_w, Z3)
+                else:
+                    self._add_wrench(el.name, joint.child, tau * axis_w, Z3, Z3)
+                    if joint.parent != "ground":
+                        self._add_wrench(el.name, joint.parent, -tau * axis_w, Z3, m.rho_p)
+            elif el.kind == "bushing":
+                a, b = el.frames
+                pa, pb = vec("point_a"), vec("point_b")
+                Ra = self._R_world(a)
+                pbw = self._world_point(b, pb)
+                x = self.s(Ra.T * (pbw - self._world_point(a, pa)))
+                Rrel = self.s(Ra.T * self._R_world(b))
+                theta = sympy.Matrix([Rrel[2, 1] - Rrel[1, 2], Rrel[0, 2] - Rrel[2, 0],
+                                      Rrel[1, 0] - Rrel[0, 1]]) / 2
+                xd = self.s(self.D(x))
+                thd = self.s(Ra.T * (self._omega_world(b) - self._omega_world(a)))
+                K = sympy.Matrix(6, 6, [exact(v) for v in np.ravel(p["stiffness"])])
+                C = sympy.Matrix(6, 6, [exact(v) for v in np.ravel(p["damping"])])
+                w6 = -(K * x.col_join(theta) + C * xd.col_join(thd))
+                f, mo = self.s(Ra * w6[:3, 0]), self.s(Ra * w6[3:, 0])
+                self._add_wrench(el.name, b, f, mo, pb)
+                self._add_wrench(el.name, a, -f, -mo, self._own_point(a, pbw))
+            elif el.kind == "bearing":
+                a, b = el.frames
+                Rb = self._R_world(b)
+                e1, e2 = self.s(Rb * vec("e1")), self.s(Rb * vec("e2"))
+                pa = vec("point")
+                paw = self._world_point(a, pa)
+                d = paw - self._world_point(b, vec("center"))
+                x, y = (e1.T * d)[0], (e2.T * d)[0]
+                xd, yd = self.D(x), self.D(y)
+                kxx, kxy, kyx, kyy, cxx, cxy, cyx, cyy = (
+                    self._coefficient(el, c) for c in ("kxx", "kxy", "kyx", "kyy", "cxx",
+                                                        "cxy", "cyx", "cyy"))
+                fx = -(kxx * x + kxy * y + cxx * xd + cxy * yd)
+                fy = -(kyx * x + kyy * y + cyx * xd + cyy * yd)
+                f = self.s(e1 * fx + e2 * fy)
+                self._add_wrench(el.name, a, f, Z3, pa)
+                self._add_wrench(el.name, b, -f, Z3, self._own_point(b, paw))
+            else:                                           # contact
+                a = el.frames[0]
+                n = vec("plane_normal")
+                radius = self._param(el, "radius")
+                centre = self._world_point(a, vec("center"))
+                if p["shape"] == "disk":
+                    ax = self._R_world(a) * vec("axis")
+                    side = -n + (n.T * ax)[0] * ax
+                    pc = centre + radius * side / sympy.sqrt((side.T * side)[0])
+                else:
+                    pc = centre - radius * n
+                pc = self.s(pc)
+                delta = -((pc - vec("plane_point")).T * n)[0]
+                own = self._own_point(a, pc)
+                vc = self._world_velocity(a) + self._omega_world(a).cross(
+                    pc - self._world_point(a, Z3))
+                vn = (vc.T * n)[0]
+                k = self._param(el, "stiffness")
+                ex = self._param(el, "exponent")
+                chc = exact(p["damping_factor"])
+                fn = sympy.Max(0, k * delta ** ex * (1 - chc * vn))
+                vt = vc - vn * n
+                ft = -self._param(el, "friction") * fn / sympy.sqrt(
+                    (vt.T * vt)[0] + self._param(el, "slip_speed") ** 2)
+                f = (fn * n + ft * vt).applyfunc(
+                    lambda e: sympy.Piecewise((e, delta > 0), (0, True)))
+                self._add_wrench(el.name, a, f, Z3, own)
+
+    def _law(self, law, x, v):
+        """A law's expression with the elongation ``x`` and its rate ``v`` put in."""
+        e = law.expression
+        e = e.xreplace({s: (x if s.name == "x" else v) for s in e.free_symbols
+                        if s.name in ("x", "v")})
+        return canonical(e, self.sym.table)
+
+    def _world_velocity(self, frame):
+        """World velocity of a frame's origin."""
+        m = self.by_name[frame]
+        return self.s(self.absolute_T(frame).T * m.v) if self.frames == "own" else m.v
 
     # ------------------------------------------------------------------ for the methods
     def point_jacobians(self, m, point):

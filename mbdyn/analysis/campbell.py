@@ -1,0 +1,229 @@
+"""Campbell diagrams: modes against a parameter (a rotor's spin speed), tracked by shape.
+
+At each value the equilibrium is found again (warm-started from the previous one), the
+model linearised and its modes computed.  Modes are followed from one value to the next by
+their shapes -- the modal assurance criterion ``MAC = |a^H b|^2 / (|a|^2 |b|^2)``, matched
+by the assignment that maximises the total MAC -- not by sorting frequencies, which swaps
+the labels of two modes where their frequencies cross.  Reported: each tracked mode's
+frequency, damping and whirl against the parameter; the critical speeds, where a mode's
+frequency meets an ``n x`` spin line (``n`` in ``orders``); and the onset of instability,
+where a mode's real part crosses zero.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ModelError
+from .equilibrium import EquilibriumError, equilibrium
+from .linearize import linearize
+from .modes import modes as compute_modes
+
+
+def mac(a, b):
+    """Modal assurance criterion of two complex shapes (1: the same shape)."""
+    num = abs(np.vdot(a, b)) ** 2
+    den = np.vdot(a, a).real * np.vdot(b, b).real
+    return float(num / den) if den > 0 else 0.0
+
+
+@dataclass
+class Campbell:
+    """``values`` of ``parameter``; per tracked mode (columns) the damped frequency
+    ``frequency`` (rad/s), ``real_part``, ``damping_ratio`` and ``whirl``; ``mac`` the
+    shape correlation of each step; ``critical`` ``[(mode, order, value)]``; ``onset``
+    ``[(mode, value)]``."""
+    parameter: str
+    values: np.ndarray
+    frequency: np.ndarray
+    real_part: np.ndarray
+    damping_ratio: np.ndarray
+    whirl: list
+    mac: np.ndarray
+    critical: list = field(default_factory=list)
+    onset: list = field(default_factory=list)
+    spin_is_parameter: bool = True
+
+    def to_dict(self):
+        return {"parameter": self.parameter, "values": self.values.tolist(),
+                "modes": [{"frequency": self.frequency[:, k].tolist(),
+                           "real_part": self.real_part[:, k].tolist(),
+                           "damping_ratio": self.damping_ratio[:, k].tolist(),
+                           "whirl": [w[k] for w in self.whirl]}
+                          for k in range(self.frequency.shape[1])],
+                "tracking_mac_min": float(self.mac.min()) if self.mac.size else 1.0,
+                "critical_speeds": [{"mode": m + 1, "order": o, "value": v}
+                                    for m, o, v in self.critical],
+                "instability_onset": [{"mode": m + 1, "value": v} for m, v in self.onset]}
+
+    def table(self):
+        n = self.frequency.shape[1]
+        head = f"{self.parameter:>12} " + " ".join(f"{'mode ' + str(k + 1):>14}"
+                                                   for k in range(n))
+        lines = [head + "   (damped frequency rad/s, whirl F/B, * unstable)"]
+        for i, v in enumerate(self.values):
+            cells = []
+            for k in range(n):
+                w = self.whirl[i][k]
+                mark = ("F" if w == "forward" else "B" if w == "backward" else " ")
+                star = "*" if self.real_part[i, k] > 0 else " "
+                cells.append(f"{self.frequency[i, k]:>12.5g}{mark}{star}")
+            lines.append(f"{v:>12.6g} " + " ".join(cells))
+        for m, o, v in self.critical:
+            lines.append(f"critical speed: mode {m + 1} meets the {o}x line at "
+                         f"{self.parameter} = {v:.6g}")
+        for m, v in self.onset:
+            lines.append(f"onset of instability: mode {m + 1} at {self.parameter} = {v:.6g}")
+        if not self.onset:
+            lines.append("no instability in the range")
+        return "\n".join(lines)
+
+    def plot(self, path=None, orders=(1,)):
+        """Frequency against the parameter: whirl by marker (^ forward, v backward),
+        damping ratio by colour, the spin lines; saved to ``path`` when given."""
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        fig, ax = plt.subplots(figsize=(7, 4.5))
+        zeta = np.clip(self.damping_ratio, -0.2, 0.5)
+        for k in range(self.frequency.shape[1]):
+            f = np.where(self.frequency[:, k] > 0, self.frequency[:, k], np.nan)
+            ax.plot(self.values, f, "-", color="0.75", lw=1, zorder=1)
+            for marker, tag in (("^", "forward"), ("v", "backward"), ("o", None)):
+                sel = np.array([w[k] == tag for w in self.whirl]) & (self.frequency[:, k] > 0)
+                if sel.any():
+                    sc = ax.scatter(self.values[sel], self.frequency[sel, k], c=zeta[sel, k],
+                                    cmap="coolwarm_r", vmin=-0.2, vmax=0.5, marker=marker,
+                                    s=22, zorder=2, edgecolors="k", linewidths=0.3)
+        if self.spin_is_parameter:
+            for o in orders:
+                ax.plot(self.values, o * self.values, "k--", lw=0.8, label=f"{o}x spin")
+        for m, o, v in self.critical:
+            ax.axvline(v, color="tab:orange", lw=0.8, ls=":")
+        for m, v in self.onset:
+            ax.axvline(v, color="tab:red", lw=1.2, label=f"instability onset ({v:.4g})")
+        ax.set_xlabel(f"{self.parameter}")
+        ax.set_ylabel("damped natural frequency [rad/s]")
+        ax.set_ylim(bottom=0)
+        ax.set_title("Campbell diagram (^ forward, v backward whirl; colour: damping ratio)",
+                     fontsize=9)
+        try:
+            fig.colorbar(sc, ax=ax, label="damping ratio")
+        except NameError:
+            pass
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=8, loc="upper left")
+        fig.tight_layout()
+        if path is not None:
+            fig.savefig(path, dpi=120)
+            plt.close(fig)
+        return fig
+
+
+def _crossings(x, y):
+    """Values of ``x`` where the samples ``y`` change sign (linear interpolation)."""
+    out = []
+    for i in range(len(x) - 1):
+        if y[i] == 0:
+            out.append(float(x[i]))
+        elif y[i] * y[i + 1] < 0:
+            out.append(float(x[i] - y[i] * (x[i + 1] - x[i]) / (y[i + 1] - y[i])))
+    return out
+
+
+def _builder(scene, parameter):
+    """``value -> (model, q0, u0)``: a model file's scene rebuilt with the parameter set,
+    or a user's function of the value returning a ``Model`` (or a scene)."""
+    if hasattr(scene, "rebuild"):
+        if parameter not in scene.parameters:
+            raise ModelError(f"campbell: {parameter!r} is not a parameter of {scene.path}; "
+                             f"its parameters are {', '.join(scene.parameters) or '(none)'}")
+
+        def build(v):
+            sc = scene.rebuild({f"parameters.{parameter}": float(v)})
+            return sc.model, sc.q0, sc.u0
+        return build
+    if callable(scene):
+        def build(v):
+            out = scene(float(v))
+            if hasattr(out, "model"):
+                return out.model, out.q0, out.u0
+            return out, out.default_coordinates(), np.zeros(out.nu)
+        return build
+    raise ModelError("campbell: give a scene (mb.load_model) or a function of the parameter "
+                     "value that returns a compiled Model")
+
+
+def campbell(scene, parameter, values, orders=(1,), whirl=(), at="equilibrium",
+             fixed=(), spin_is_parameter=True):
+    """Modes against ``parameter`` over ``values``; see the module docstring.
+
+    ``scene``: a model file's scene (``parameter`` is a name in its ``[parameters]``; the
+    scene's case, overrides and effects are kept) or a function ``value -> Model``.
+    ``at``: ``"equilibrium"`` (found again at each value, warm-started) or ``"initial"``
+    (the scene's initial configuration).  ``whirl``: lateral coordinate pairs (see
+    ``analysis.modes``); ``orders``: the spin lines ``n x`` for critical speeds.
+    """
+    if at not in ("equilibrium", "initial"):
+        raise ModelError(f"campbell: at must be 'equilibrium' or 'initial', got {at!r}")
+    build = _builder(scene, parameter)
+    values = np.asarray(values, dtype=float)
+    if values.ndim != 1 or len(values) < 2 or not np.all(np.isfinite(values)):
+        raise ModelError("campbell: give at least two finite parameter values")
+    guess = None
+    rows = []
+    for v in values:
+        model, q0, _ = build(v)
+        q = q0 if guess is None or at == "initial" else guess
+        if at == "equilibrium":
+            try:
+                eq = equilibrium(model, q, np.zeros(model.nu), fixed=fixed)
+            except EquilibriumError as exc:
+                raise ModelError(f"campbell: at {parameter} = {v:g}: {exc}") from None
+            q = eq.q
+        lin = linearize(model, q, np.zeros(model.nu))
+        guess = q
+        sign = np.sign(v) if spin_is_parameter and v != 0 else 1.0
+        rows.append(compute_modes(lin, whirl=whirl, spin=sign))
+    n = min(len(r.modes) for r in rows)
+    # track: assign the modes of each step to those of the previous by MAC
+    order = [list(range(n))]
+    macs = []
+    for i in range(1, len(rows)):
+        prev = [rows[i - 1].modes[j] for j in order[-1]]
+        cur = rows[i].modes
+        score = np.array([[mac(p.shape, c.shape) for c in cur[:max(n, len(cur))]]
+                          for p in prev])
+        # add a small frequency-proximity term to break ties between equal shapes
+        fp = np.array([[p.damped_frequency for _ in cur[:score.shape[1]]] for p in prev])
+        fc = np.array([[c.damped_frequency for c in cur[:score.shape[1]]] for _ in prev])
+        cost = -(score - 1e-3 * np.abs(fp - fc) / (np.abs(fp) + np.abs(fc) + 1e-300))
+        from scipy.optimize import linear_sum_assignment
+        r_, c_ = linear_sum_assignment(cost)
+        assigned = [int(c) for _, c in sorted(zip(r_, c_))]
+        order.append(assigned)
+        macs.append([score[a, b] for a, b in zip(range(n), assigned)])
+    freq = np.array([[rows[i].modes[j].damped_frequency for j in order[i]]
+                     for i in range(len(rows))])
+    real = np.array([[rows[i].modes[j].eigenvalue.real for j in order[i]]
+                     for i in range(len(rows))])
+    zeta = np.array([[rows[i].modes[j].damping_ratio for j in order[i]]
+                     for i in range(len(rows))])
+    whirls = [[rows[i].modes[j].whirl for j in order[i]] for i in range(len(rows))]
+    critical, onset = [], []
+    for k in range(n):
+        if spin_is_parameter:
+            oscillating = freq[:, k] > 0
+            for o in orders:
+                gap = freq[:, k] - o * np.abs(values)
+                for i in range(len(values) - 1):     # only where the mode oscillates
+                    if oscillating[i] and oscillating[i + 1]:
+                        critical.extend((k, o, v) for v in _crossings(values[i:i + 2],
+                                                                        gap[i:i + 2]))
+        for v in _crossings(values, real[:, k]):
+            onset.append((k, v))
+    critical.sort(key=lambda c: c[2])
+    onset.sort(key=lambda c: c[1])
+    return Campbell(parameter, values, freq, real, zeta, whirls, np.array(macs),
+                    critical, onset, spin_is_parameter)

@@ -1,0 +1,161 @@
+"""Equilibria by Newton-Raphson: static (``u = 0``) and steady (relative) ones.
+
+An equilibrium is a configuration ``q`` where the generalized forces of the Jourdain form
+vanish at the given speeds, ``f(q, u, t) = 0``, so that ``u' = 0``: with ``u = 0`` a static
+equilibrium; with the spin speeds of cyclic coordinates held (``u`` given, their
+coordinates in ``fixed``) a steady motion; with drives turning at constant rates, a
+relative equilibrium in the drives' moving frame -- exact when the equations do not depend
+on time there (the textbook's rotating pendulum with its disk at rest on the arm, or with
+the disk on the arm's axis), an instantaneous one otherwise (``time_dependent`` says so).
+
+Newton-Raphson on the tangent coordinates (``analysis.tangent``) with the model's own
+Jacobian ``df/dq`` (central differences of the compiled model), a backtracking line
+search on ``|f|``, and ``scipy.optimize.root`` as the fallback.  A failure is an
+``EquilibriumError`` carrying the last iterate; the result reports the residual, the
+iterations and the Jacobian's condition number.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ModelError
+from .tangent import Tangent
+
+
+class EquilibriumError(ModelError):
+    """No equilibrium was found; ``last`` holds the last iterate's coordinates."""
+
+    def __init__(self, message, last=None, residual=None):
+        super().__init__(message)
+        self.last = last
+        self.residual = residual
+
+
+@dataclass
+class Equilibrium:
+    """``q``, ``u`` and ``t`` of an equilibrium, with how it was found."""
+    model: object
+    q: np.ndarray
+    u: np.ndarray
+    t: float
+    residual: float
+    iterations: int
+    condition: float
+    method: str
+    time_dependent: bool = False
+
+    def to_dict(self):
+        m = self.model
+        return {"q": dict(zip(m.coordinates, self.q.tolist())),
+                "u": dict(zip(m.speeds, self.u.tolist())), "t": self.t,
+                "residual": self.residual, "iterations": self.iterations,
+                "condition": self.condition, "method": self.method,
+                "time_dependent": self.time_dependent}
+
+
+def _unknowns(model, tangent, fixed):
+    """Tangent indices that move: all but those of the ``fixed`` coordinates/joints."""
+    fixed = [fixed] if isinstance(fixed, str) else list(fixed or ())
+    known = set(tangent.names) | set(model.coordinates) | set(model.joints)
+    for name in fixed:
+        if name not in known:
+            raise ModelError(f"equilibrium: unknown coordinate {name!r} to hold fixed; the "
+                             f"coordinates are {', '.join(tangent.names)}")
+    held = {k for k, nm in enumerate(tangent.names)
+            if nm in fixed or model._speed_joint[k] in fixed}
+    return [k for k in range(tangent.n) if k not in held]
+
+
+def equilibrium(model, q_guess=None, u=None, t=0.0, fixed=(), tol=1e-10, max_iter=50):
+    """An equilibrium of ``model`` near ``q_guess`` (array or ``{name: value}``; default
+    the zero configuration) at speeds ``u`` (default zero) and time ``t``.
+
+    ``fixed``: coordinates (or joints) held at their guessed values, e.g. the cyclic spin
+    angle of a rotor; their equations are left out too.  ``tol``: on the residual
+    ``|f|`` relative to the size of the forces at the guess.
+    """
+    q0 = model.q_vector(dict(q_guess) if isinstance(q_guess, dict) else q_guess).copy()
+    u = model.u_vector(dict(u) if isinstance(u, dict) else u).copy()
+    if not (np.all(np.isfinite(q0)) and np.all(np.isfinite(u))):
+        raise ModelError("equilibrium: the guess holds non-finite values")
+    model.normalize_quaternions(q0)
+    tangent = Tangent(model, q0)
+    free = _unknowns(model, tangent, fixed)
+    if not free:
+        raise ModelError("equilibrium: every coordinate is held fixed; nothing to solve")
+
+    def residual(x_free):
+        x = np.zeros(tangent.n)
+        x[free] = x_free
+        return model.forcing(tangent.retract(x), u, t)[free]
+
+    def jacobian(x_free, r0):
+        h = np.cbrt(np.finfo(float).eps)
+        J = np.empty((len(free), len(free)))
+        for j in range(len(free)):
+            e = np.zeros(len(free))
+            e[j] = h
+            J[:, j] = (residual(x_free + e) - residual(x_free - e)) / (2 * h)
+        return J
+
+    x = np.zeros(len(free))
+    r = residual(x)
+    scale = max(np.abs(r).max(), np.abs(model.forcing(q0, u, t)).max(),
+                np.abs(np.diag(model.mass_matrix(q0, t))).max() * 9.81, 1e-300)
+    iterations, method, cond = 0, "newton", np.inf
+    while np.abs(r).max() > tol * scale and iterations < max_iter:
+        iterations += 1
+        J = jacobian(x, r)
+        cond = float(np.linalg.cond(J))
+        try:
+            dx = np.linalg.solve(J, -r)
+        except np.linalg.LinAlgError:
+            break
+        lam, norm0 = 1.0, np.linalg.norm(r)
+        while lam > 1e-6:                      # backtracking line search on |f|
+            trial = residual(x + lam * dx)
+            if np.all(np.isfinite(trial)) and np.linalg.norm(trial) < (1 - 1e-4 * lam) * norm0:
+                break
+            lam *= 0.5
+        if lam <= 1e-6:
+            break
+        x = x + lam * dx
+        r = residual(x)
+    if np.abs(r).max() > tol * scale:
+        from scipy.optimize import root
+        sol = root(residual, x, method="hybr", options={"xtol": 1e-14})
+        method = "scipy.optimize.root (hybr)"
+        if np.all(np.isfinite(sol.x)) and np.abs(residual(sol.x)).max() <= tol * scale:
+            x, r = sol.x, residual(sol.x)
+            cond = float(np.linalg.cond(jacobian(x, r)))
+            iterations += int(sol.nfev)
+        else:
+            xf = np.zeros(tangent.n)
+            xf[free] = x
+            last = tangent.retract(xf)
+            raise EquilibriumError(
+                f"model {model.name!r}: no equilibrium found from the guess (residual "
+                f"{np.abs(r).max():.3g} after {iterations} Newton iterations and the "
+                f"fallback); try another guess, hold cyclic coordinates fixed, or check "
+                "that the model can rest (a spinning body needs its spin speed in u)",
+                last=last, residual=float(np.abs(r).max()))
+    xf = np.zeros(tangent.n)
+    xf[free] = x
+    q = tangent.retract(xf)
+    model.normalize_quaternions(q)
+    near = {j: d for j, d in model.euler_singularity(q).items() if d < 1e-6}
+    if near:
+        import warnings
+
+        from ..errors import SingularityWarning
+        warnings.warn(f"model {model.name!r}: the equilibrium found puts the Euler angles of "
+                      f"{', '.join(near)} at their singular configuration; the angle rates and "
+                      "the mass matrix are singular there -- try another guess, or a "
+                      "spherical joint", SingularityWarning, stacklevel=2)
+    # the equations at other times: do they still vanish (a relative equilibrium)?
+    later = [model.forcing(q, u, t + dt)[free] for dt in (0.37, 1.3, 4.1)]
+    time_dependent = bool(max(np.abs(f).max() for f in later) > 1e3 * tol * scale)
+    return Equilibrium(model, q, u, float(t), float(np.abs(r).max()), iterations, cond,
+                       method, time_dependent)

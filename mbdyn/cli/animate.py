@@ -1,0 +1,42 @@
+"""``mbdyn animate MODEL --out FILE.gif|.mp4|.html``: simulate and animate.
+
+    mbdyn animate MODEL [--case NAME] [--set PATH=VALUE ...] [--effects LIST]
+                        [--out FILE] [--speed S] [--fps F]
+"""
+from __future__ import annotations
+
+import os
+import sys
+
+from .common import Progress, add_model_arguments, load
+
+
+def register(subparsers):
+    p = subparsers.add_parser(
+        "animate", help="animate a run: GIF, MP4 or a self-contained HTML view",
+        description="Simulate the model with its [simulation] settings and write an "
+                    "animation: real-time playback (--speed to change), bodies with their "
+                    "shapes, trails of the centres of mass, the time shown.  .html is one "
+                    "file that opens offline, with orbit/zoom, play/pause and a time slider.")
+    add_model_arguments(p)
+    p.add_argument("--out", metavar="FILE", help=".gif, .mp4 (needs the video extra) or "
+                                                 ".html (default STEM.gif)")
+    p.add_argument("--speed", type=float, default=1.0, help="playback speed (default 1: "
+                                                            "real time)")
+    p.add_argument("--fps", type=float, default=30.0, help="frames per second (default 30)")
+    p.set_defaults(func=run)
+
+
+def run(args):
+    from ..viz.animate import animate, check_output
+    scene = load(args)
+    out = args.out or os.path.splitext(os.path.basename(scene.path))[0] + (
+        f"_{scene.case}" if scene.case else "") + ".gif"
+    check_output(out)                      # before the run: a bad request costs nothing
+    progress = Progress(scene.settings.get("t_end") or 0.0)
+    result = scene.simulate(progress=progress)
+    progress.close()
+    n = animate(result, out, speed=args.speed, fps=args.fps,
+                title=f"{scene.name}{' (case ' + scene.case + ')' if scene.case else ''}")
+    sys.stdout.write(f"wrote {out} ({n} frames, {os.path.getsize(out) / 1e6:.2f} MB)\n")
+    return 0

@@ -1,0 +1,43 @@
+"""``mbdyn equilibrium MODEL``: a static or steady equilibrium near the initial state.
+
+    mbdyn equilibrium MODEL [--case NAME] [--set PATH=VALUE ...] [--effects LIST]
+                            [--fixed NAMES] [--t T] [--json]
+"""
+from __future__ import annotations
+
+import json
+import sys
+
+from .common import add_model_arguments, fmt, load
+from .vibration_args import add_vibration_arguments, names
+
+
+def register(subparsers):
+    p = subparsers.add_parser(
+        "equilibrium", help="static or steady equilibrium by Newton-Raphson",
+        description="Find the configuration where the generalized forces vanish at the "
+                    "initial speeds (zero unless the file gives spin speeds), starting from "
+                    "the initial coordinates.")
+    add_model_arguments(p)
+    add_vibration_arguments(p, whirl=False)
+    p.set_defaults(func=run)
+
+
+def run(args):
+    from ..analysis.equilibrium import equilibrium
+    scene = load(args)
+    eq = equilibrium(scene.model, scene.q0, scene.u0, t=args.t, fixed=names(args.fixed))
+    if args.json:
+        sys.stdout.write(json.dumps({"model": scene.name, "case": scene.case,
+                                     "equilibrium": eq.to_dict()}) + "\n")
+        return 0
+    w = sys.stdout.write
+    w(f"{scene.name} ({scene.path}{', case ' + scene.case if scene.case else ''})\n")
+    w(f"  equilibrium by {eq.method}: {eq.iterations} iterations, residual "
+      f"{fmt(eq.residual)}, Jacobian condition {fmt(eq.condition)}\n")
+    if eq.time_dependent:
+        w("  (the equations depend on time here: this is the equilibrium at t only)\n")
+    width = max(len(n) for n in scene.model.coordinates)
+    for n, v in zip(scene.model.coordinates, eq.q):
+        w(f"    {n:<{width}} = {fmt(v)}\n")
+    return 0

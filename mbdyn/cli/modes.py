@@ -1,0 +1,79 @@
+"""``mbdyn modes MODEL``: linearise and list natural frequencies, damping and shapes.
+
+    mbdyn modes MODEL [--case NAME] [--set PATH=VALUE ...] [--effects LIST]
+                      [--at equilibrium|initial] [--route numeric|symbolic]
+                      [--fixed NAMES] [--whirl Y,Z ...] [--t T] [--json]
+"""
+from __future__ import annotations
+
+import json
+import sys
+
+from .common import add_model_arguments, load
+from .vibration_args import add_vibration_arguments, names, whirl_pairs
+
+
+def register(subparsers):
+    p = subparsers.add_parser(
+        "modes", help="natural frequencies, damping ratios and mode shapes",
+        description="Linearise the model about its equilibrium (or its initial state) into "
+                    "M x'' + (D + G) x' + (K + N) x = 0 and list its modes and stability.")
+    add_model_arguments(p)
+    p.add_argument("--at", choices=("equilibrium", "initial"), default="equilibrium",
+                   help="operating point (default: the equilibrium near the initial state)")
+    p.add_argument("--route", choices=("numeric", "symbolic"), default="numeric",
+                   help="derivatives by central differences (default) or from the closed-form "
+                        "equations")
+    p.add_argument("--matrices", action="store_true", help="also print M, D, G, K, N")
+    p.add_argument("--animate", metavar="FILE", help="animate a mode shape about the "
+                   "operating point: .gif, .mp4 or .html")
+    p.add_argument("--mode", type=int, default=1, metavar="K",
+                   help="which mode --animate draws (1 = the lowest, as listed)")
+    p.add_argument("--amplitude", type=float, default=0.1,
+                   help="--animate's amplitude in the tangent coordinates (rad or m)")
+    add_vibration_arguments(p)
+    p.set_defaults(func=run)
+
+
+def run(args):
+    import numpy as np
+
+    from ..analysis.equilibrium import equilibrium
+    from ..analysis.linearize import linearize
+    from ..analysis.modes import modes
+    scene = load(args)
+    model = scene.model
+    q, u = scene.q0, scene.u0
+    eq = None
+    if args.at == "equilibrium":
+        eq = equilibrium(model, q, u, t=args.t, fixed=names(args.fixed))
+        q = eq.q
+    if args.animate:
+        from ..viz.animate import check_output
+        check_output(args.animate)
+    lin = linearize(model, q, u, t=args.t, route=args.route)
+    md = modes(lin, whirl=whirl_pairs(args))
+    if args.animate:
+        from ..errors import ModelError
+        from ..viz.modeshape import animate_mode
+        if not 1 <= args.mode <= len(md):
+            raise ModelError(f"--mode {args.mode}: the model has modes 1 to {len(md)}")
+        animate_mode(lin, md[args.mode - 1], args.animate, amplitude=args.amplitude)
+        sys.stderr.write(f"mbdyn: wrote {args.animate}\n")
+    if args.json:
+        sys.stdout.write(json.dumps({"model": scene.name, "case": scene.case, "at": args.at,
+                                     "equilibrium": eq.to_dict() if eq else None,
+                                     "linearization": lin.to_dict(),
+                                     **md.to_dict()}) + "\n")
+        return 0
+    w = sys.stdout.write
+    w(f"{scene.name} ({scene.path}{', case ' + scene.case if scene.case else ''}): "
+      f"linearised at the {args.at} state by the {args.route} route"
+      + (f" (error estimate {lin.error:.1e})" if lin.route == "numeric" else "") + "\n")
+    w(f"  coordinates: {', '.join(lin.names)}\n")
+    if args.matrices:
+        with np.printoptions(precision=6, suppress=False, linewidth=100):
+            for k in ("M", "D", "G", "K", "N"):
+                w(f"  {k} =\n{getattr(lin, k)}\n")
+    w(md.table() + "\n")
+    return 0

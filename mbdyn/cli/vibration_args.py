@@ -1,0 +1,55 @@
+"""Arguments shared by ``mbdyn equilibrium``, ``mbdyn modes`` and ``mbdyn campbell``."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ModelError
+
+
+def add_vibration_arguments(p, whirl=True):
+    p.add_argument("--fixed", metavar="NAMES", default="",
+                   help="coordinates or joints held at their initial values (comma-separated),"
+                        " e.g. a cyclic spin angle")
+    p.add_argument("--t", type=float, default=0.0, metavar="T",
+                   help="time of the operating point (drives, time-dependent loads)")
+    if whirl:
+        p.add_argument("--whirl", metavar="Y,Z", action="append", default=[],
+                       help="a pair of lateral coordinates across the spin axis (Y x Z along "
+                            "the spin), to tell forward from backward whirl; repeatable")
+    p.add_argument("--json", action="store_true", help="one JSON object on stdout")
+
+
+def names(text):
+    return [n.strip() for n in str(text).split(",") if n.strip()]
+
+
+def whirl_pairs(args):
+    pairs = []
+    for item in args.whirl:
+        pair = names(item)
+        if len(pair) != 2:
+            raise ModelError(f"--whirl {item!r}: give two coordinate names, e.g. --whirl y,z")
+        pairs.append(tuple(pair))
+    return pairs
+
+
+def value_range(text):
+    """``START:STOP:N`` (linear), ``START:STOP:Nlog`` (logarithmic) or ``a,b,c``."""
+    text = str(text).strip()
+    try:
+        if ":" in text:
+            start, stop, n = text.split(":")
+            log = n.endswith("log")
+            n = int(n[:-3] if log else n)
+            if n < 2:
+                raise ValueError
+            if log:
+                return np.geomspace(float(start), float(stop), n)
+            return np.linspace(float(start), float(stop), n)
+        values = np.array([float(v) for v in text.split(",")])
+    except ValueError:
+        raise ModelError(f"--values {text!r}: give START:STOP:N (N >= 2), START:STOP:Nlog "
+                         "or a comma-separated list of numbers") from None
+    if len(values) < 2 or not np.all(np.isfinite(values)):
+        raise ModelError(f"--values {text!r}: give at least two finite values")
+    return values

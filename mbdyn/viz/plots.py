@@ -1,0 +1,180 @@
+"""Time series and phase portraits of a ``Result``.
+
+Series are named as the columns of ``mbdyn run --out``'s CSV: a coordinate or speed
+(``theta1``, ``theta1_dot``), ``energy_kinetic`` ... ``energy_balance``,
+``reaction_JOINT_Fx`` ... ``_Mz``, ``effort_JOINT``, ``point_NAME_x`` ...; a group's prefix
+(``energy``, ``reaction_JOINT``, ``point_NAME``) stands for all its columns.  Each series
+is labelled with its unit; series of one unit share an axis; event times are marked.
+"""
+from __future__ import annotations
+
+import os
+import tempfile
+
+import numpy as np
+
+from ..errors import ModelError
+
+FORMATS = (".png", ".pdf", ".svg")
+SERIES_HELP = ("coordinates, speeds, energy_* (kinetic, potential, total, dissipated, work, "
+               "balance), reaction_JOINT_Fx..Mz, effort_JOINT, point_NAME_x/_y/_z, or a "
+               "group prefix: energy, reaction_JOINT, point_NAME")
+
+
+def _units(model):
+    """``{series name: unit}`` of the coordinates and speeds."""
+    out = {}
+    for j in model.elements[1]:
+        if j.drive is not None or not j.nu:
+            continue
+        if j.kind == "prismatic":
+            q_units, u_units = ["m"], ["m/s"]
+        elif j.kind == "revolute" or j.kind == "euler":
+            q_units, u_units = ["rad"] * j.nq, ["rad/s"] * j.nu
+        elif j.kind == "spherical":
+            q_units, u_units = ["-"] * 4, ["rad/s"] * 3
+        else:   # free
+            q_units, u_units = ["m"] * 3 + ["-"] * 4, ["m/s"] * 3 + ["rad/s"] * 3
+        out.update(zip(j.coordinates, q_units))
+        out.update(zip(j.speeds, u_units))
+    return out
+
+
+def series_table(result):
+    """``{name: (values (n,), unit, label)}`` of everything a result holds."""
+    model = result.model
+    units = _units(model)
+    table = {}
+    for k, n in enumerate(model.coordinates):
+        table[n] = (result.q[:, k], units.get(n, "-"), n)
+    for k, n in enumerate(model.speeds):
+        table[n] = (result.u[:, k], units.get(n, "-"), n)
+    if result.energy is not None:
+        for key, arr in result.energy.items():
+            table[f"energy_{key}"] = (np.asarray(arr), "J", f"energy {key}")
+    if result.reactions is not None:
+        for j, arr in result.reactions.items():
+            for c, comp in enumerate(("Fx", "Fy", "Fz", "Mx", "My", "Mz")):
+                table[f"reaction_{j}_{comp}"] = (np.asarray(arr)[:, c],
+                                                 "N" if comp[0] == "F" else "N m",
+                                                 f"reaction {j} {comp}")
+    if result.drive_efforts:
+        for j, arr in result.drive_efforts.items():
+            kind = model.joint(j).kind
+            table[f"effort_{j}"] = (np.asarray(arr), "N m" if kind == "revolute" else "N",
+                                    f"drive effort {j}")
+    if result.points:
+        for p, arr in result.points.items():
+            for c, axis in enumerate("xyz"):
+                table[f"point_{p}_{axis}"] = (np.asarray(arr)[:, c], "m", f"{p} {axis}")
+    return table
+
+
+def _expand(names, table):
+    out = []
+    for name in names:
+        if name in table:
+            out.append(name)
+            continue
+        group = [k for k in table if k.startswith(name + "_")]
+        if not group:
+            raise ModelError(f"unknown series {name!r}; this result has: "
+                             f"{', '.join(table)} (or a group: energy, reaction_JOINT, "
+                             "point_NAME)")
+        out.extend(group)
+    return out
+
+
+def _check_path(path):
+    ext = os.path.splitext(str(path))[1].lower()
+    if ext not in FORMATS:
+        raise ModelError(f"{path}: unknown picture format {ext or '(none)'!r}; use one of "
+                         f"{', '.join(FORMATS)}")
+    directory = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(directory):
+        raise ModelError(f"{path}: the directory {directory} does not exist")
+    if not os.access(directory, os.W_OK):
+        raise ModelError(f"{path}: cannot write into {directory} (permission denied)")
+
+
+def _save(fig, path):
+    """Write via a temporary file in the same directory and rename: no partial file."""
+    ext = os.path.splitext(str(path))[1].lower()
+    directory = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(prefix=".plot.", suffix=ext, dir=directory)
+    os.close(fd)
+    try:
+        fig.savefig(tmp, dpi=110)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def plot_result(result, series=None, phase=None, out=None, title=None):
+    """Plot ``series`` (names or group prefixes; default: the coordinates, and the energy
+    balance when the result has one) against time, one axis per unit, event times marked;
+    or, with ``phase=(X, Y)``, a phase portrait of two series.  Saves to ``out`` (.png, .pdf,
+    .svg) when given; returns the matplotlib figure."""
+    if out is not None:
+        _check_path(out)
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        raise ModelError("pictures need matplotlib: pip install \"mbdyn[plot]\"") from None
+    table = series_table(result)
+    title = title or result.model.name
+    if phase is not None:
+        if isinstance(phase, str):
+            phase = [p.strip() for p in phase.split(",")]
+        if len(phase) != 2:
+            raise ModelError(f"phase {phase!r}: give two series, e.g. theta1,theta1_dot")
+        for p in phase:
+            if p not in table:
+                raise ModelError(f"unknown series {p!r}; this result has: {', '.join(table)}")
+        (x, ux, lx), (y, uy, ly) = table[phase[0]], table[phase[1]]
+        fig, ax = plt.subplots(figsize=(5.5, 5))
+        ax.plot(x, y, lw=1)
+        ax.plot(x[0], y[0], "o", color="tab:green", label=f"t = {result.t[0]:g} s")
+        ax.plot(x[-1], y[-1], "s", color="tab:red", label=f"t = {result.t[-1]:g} s")
+        ax.set_xlabel(f"{lx} [{ux}]")
+        ax.set_ylabel(f"{ly} [{uy}]")
+        ax.set_title(f"{title}: phase portrait", fontsize=10)
+        ax.legend(fontsize=8)
+    else:
+        if series is None:
+            series = list(result.model.coordinates)
+            if result.energy is not None:
+                series += ["energy_kinetic", "energy_potential", "energy_balance"]
+        elif isinstance(series, str):
+            series = [s.strip() for s in series.split(",") if s.strip()]
+        names = _expand(series, table)
+        if not names:
+            raise ModelError("nothing to plot: give series names")
+        by_unit = {}
+        for n in names:
+            by_unit.setdefault(table[n][1], []).append(n)
+        fig, axes = plt.subplots(len(by_unit), 1, sharex=True,
+                                 figsize=(7.5, 2.2 + 1.6 * len(by_unit)), squeeze=False)
+        for ax, (unit, group) in zip(axes[:, 0], by_unit.items()):
+            for n in group:
+                ax.plot(result.t, table[n][0], lw=1.2, label=table[n][2])
+            ax.set_ylabel(f"[{unit}]")
+            ax.legend(fontsize=8, loc="best")
+            ax.grid(alpha=0.3)
+            for name, t in result.events:
+                ax.axvline(t, color="tab:red", lw=0.8, ls="--")
+        for name, t in result.events:
+            axes[0, 0].annotate(name, (t, 1.0), xycoords=("data", "axes fraction"),
+                                fontsize=8, color="tab:red", ha="right", va="bottom",
+                                rotation=90)
+        axes[-1, 0].set_xlabel("time t [s]")
+        axes[0, 0].set_title(title, fontsize=10)
+    fig.tight_layout()
+    if out is not None:
+        _save(fig, out)
+        plt.close(fig)
+    return fig

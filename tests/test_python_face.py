@@ -1,0 +1,85 @@
+"""The Python interface agrees with model files (issue 14's first points)."""
+import numpy as np
+import pytest
+
+import mbdyn as mb
+from mbdyn.io.loader import DEFAULT_SIMULATION
+
+
+def pendulum():
+    s = mb.System("pendulum", gravity=(0, 0, -9.81))
+    s.add_body("bob", mass=1.0, com=(0, 0, -1.0))
+    s.add_joint("theta", "revolute", parent="ground", child="bob", axis="y")
+    return s.compile()
+
+
+def test_one_set_of_defaults_for_python_and_files():
+    assert mb.simulate.__kwdefaults__["integrator"] == DEFAULT_SIMULATION["integrator"] == \
+        "DOP853"
+    assert mb.simulate.__kwdefaults__["rtol"] == DEFAULT_SIMULATION["rtol"] == 1e-9
+    assert mb.simulate.__kwdefaults__["atol"] == DEFAULT_SIMULATION["atol"] == 1e-12
+    # the pendulum's small-amplitude period through Python defaults is good to ~1e-9
+    model = pendulum()
+    res = mb.simulate(model, 2.0, {"theta": 1e-3}, t_eval=np.linspace(0, 2, 4001))
+    assert res.stats["integrator"] == "DOP853"
+    w = np.sqrt(9.81)
+    assert np.abs(res["theta"] - 1e-3 * np.cos(w * res.t)).max() < 1e-9
+
+
+def test_u0_accepts_a_coordinate_name_for_its_rate_as_files_do():
+    model = pendulum()
+    assert model.u_vector({"theta": 1.5}) == pytest.approx([1.5])
+    res = mb.simulate(model, 0.1, u0={"theta": 1.5})
+    assert res["theta_dot"][0] == 1.5
+    with pytest.raises(mb.ModelError, match="given twice"):
+        model.u_vector({"theta": 1.0, "theta_dot": 2.0})
+    with pytest.raises(mb.ModelError, match="unknown speed 'phi'"):
+        model.u_vector({"phi": 1.0})
+
+
+def test_a_particle_on_a_spherical_joint_is_refused_with_the_remedy():
+    s = mb.System("conical pendulum")
+    s.add_body("bob", mass=1.0, com=(0, 0, -1.0))
+    s.add_joint("ball", "spherical", parent="ground", child="bob")
+    with pytest.raises(mb.ModelError, match=r"two revolute joints.*small isotropic inertia"):
+        s.compile()
+
+
+def swinging():
+    model = pendulum()
+    return model, {"theta": 0.5}
+
+
+def test_events_accept_the_files_text_and_sympy_and_carry_the_state():
+    import sympy
+    model, q0 = swinging()
+    w = np.sqrt(9.81)
+    # small-angle crossings of theta = 0 at (k + 1/2) pi / w; 0.5 rad is not small, so the
+    # reference is a text event against a callable one, both located to 1e-9
+    text = mb.simulate(model, 2.0, q0, events=[mb.Event("cross", "theta")])
+    func = mb.simulate(model, 2.0, q0, events=[mb.Event("cross", lambda t, q, u: q[0])])
+    assert [round(t, 9) for _, t in text.events] == [round(t, 9) for _, t in func.events]
+    assert len(text.events) == 2 and abs(text.events[0].t - 0.5 * np.pi / w) < 0.02
+    down = mb.simulate(model, 2.0, q0, events=[mb.Event("down", "theta < 0")])
+    assert [e.t for e in down.events] == [text.events[0].t]     # falling only
+    th = sympy.Symbol("theta")
+    sym = mb.simulate(model, 2.0, q0, events=[mb.Event("down", th < 0)])
+    assert [e.t for e in sym.events] == pytest.approx([e.t for e in down.events], abs=1e-12)
+    rec = down.events[0]
+    name, t = rec                                   # unpacks as (name, t), as before
+    assert name == "down" and rec.q[0] == pytest.approx(0.0, abs=1e-9)
+    assert rec.state["theta_dot"] == pytest.approx(rec.u[0]) and rec.u[0] < 0
+    # terminal, with the rates named as in files
+    stop = mb.simulate(model, 2.0, q0, events=[mb.Event("turn", "theta_dot > 0", True)])
+    assert stop.t[-1] == pytest.approx(stop.events[0].t)
+
+
+def test_a_bool_condition_is_refused_with_the_remedy():
+    model, q0 = swinging()
+    with pytest.raises(mb.ModelError, match=r"returned .*a bool.*'theta < 0'"):
+        mb.simulate(model, 2.0, q0, events=[mb.Event("down", lambda t, q, u: q[0] < 0)])
+    with pytest.raises(mb.ModelError, match="event 'bad'.*not allowed|event 'bad'"):
+        mb.simulate(model, 1.0, q0, events=[mb.Event("bad", "__import__('os')")])
+    with pytest.raises(mb.ModelError, match="uses phi"):
+        import sympy
+        mb.simulate(model, 1.0, q0, events=[mb.Event("bad", sympy.Symbol("phi"))])
