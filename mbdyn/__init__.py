@@ -15,6 +15,7 @@ from .io import ModelFileError, Scene, load_model
 from .symbolic import derive
 from .analysis import (Campbell, Equilibrium, EquilibriumError, Linearization, Modes,
                        campbell, equilibrium, linearize, modes)
+from .analysis.sweep import SweepResult, sweep
 
 from . import viz
 
@@ -30,4 +31,5 @@ __all__ = ["System", "Model", "Kinematics", "Result", "Event", "simulate", "iner
            "NonFiniteError", "SimulationError", "SingularityWarning",
            "SingularMassMatrixError", "load_model", "Scene", "ModelFileError", "derive",
            "forces", "effects", "equilibrium", "linearize", "modes", "campbell",
-           "Equilibrium", "EquilibriumError", "Linearization", "Modes", "Campbell"]
+           "Equilibrium", "EquilibriumError", "Linearization", "Modes", "Campbell",
+           "sweep", "SweepResult"]

@@ -220,7 +220,7 @@ def test_kill_and_resume_gives_the_uninterrupted_table(tmp_path):
     assert list(t["member"]) == list(range(6)) and set(t["status"]) == {"ok"}
 
 
-def test_cli_json_and_plot(tmp_path, capsys):
+def test_cli_json_and_plot(tmp_path, capsys, monkeypatch):
     import json
     from mbdyn.cli import main
     args = ["sweep", PENDULUM, "--grid", "initial.theta1=0.1:0.3:2", "--grid",
@@ -233,5 +233,7 @@ def test_cli_json_and_plot(tmp_path, capsys):
     png = tmp_path / "t_final.theta1.png"
     assert main(args + ["--out", str(tmp_path / "t.csv"), "--plot", "final.theta1"]) == 0
     assert png.exists() and png.stat().st_size > 1000
+    import mbdyn.analysis.sweep as sw
+    monkeypatch.setattr(sw, "make_scheduler", lambda *a: _Refuse())   # no member may run
     assert main(args + ["--plot", "nope", "--plot-file", str(png)]) == 1
     assert "not a column" in capsys.readouterr().err

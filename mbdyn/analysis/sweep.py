@@ -535,7 +535,7 @@ def _progress(total, enabled):
 
 def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, fixed=None,
           scheduler="serial", workers=None, out=None, resume=False, batched=False,
-          batch_size=None, progress=None):
+          batch_size=None, progress=None, require_columns=()):
     """Run the model file ``model`` (a path or a ``Scene`` loaded from one) over
     ``overrides`` and return a ``SweepResult``.
 
@@ -551,6 +551,7 @@ def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, f
     ``batched``: advance members that share one compiled model in one compiled call
     (fixed-step schemes only; see ``batchable``), ``batch_size`` members per task.
     ``progress``: show a bar on stderr (default: when stderr is a terminal).
+    ``require_columns``: columns the caller will need (e.g. to plot), checked up front.
 
     Everything that can be checked is checked before any member runs: the paths, the
     range texts, the quantities, an empty sweep.
@@ -586,6 +587,10 @@ def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, f
     paths = [p for p, _ in members[0]["overrides"]]
     with_case = cases is not None and len(members) > 0 and len(set(m["case"] for m in members)) > 1
     head = ["member"] + (["case"] if with_case else []) + paths + ["status", "error"] + header
+    missing = [c for c in require_columns if c not in head]
+    if missing:
+        raise ModelError(f"{', '.join(missing)}: not a column of the table; the columns are: "
+                         + ", ".join(head))
     for i, m in enumerate(members):
         m["index"] = i
     spec = hashlib.sha256(json.dumps([text, members, fixed_list, list(quantities)],

@@ -82,7 +82,8 @@ def run(args):
     result = sweep(args.model, grid, tuple(args.quantities or DEFAULT_QUANTITIES),
                    cases=args.case, fixed=_fixed(args.fixed), scheduler=args.scheduler,
                    workers=args.workers, out=args.out, resume=args.resume,
-                   batched=args.batched, progress=False if args.json else None)
+                   batched=args.batched, progress=False if args.json else None,
+                   require_columns=[args.plot] if args.plot else [])
     if args.plot:
         from ..viz.sweep_plots import plot_sweep
         plot_sweep(result, args.plot, plot_file, axes=list(grid))
