@@ -83,3 +83,47 @@ def test_a_bool_condition_is_refused_with_the_remedy():
     with pytest.raises(mb.ModelError, match="uses phi"):
         import sympy
         mb.simulate(model, 1.0, q0, events=[mb.Event("bad", sympy.Symbol("phi"))])
+
+
+def test_inverse_dynamics_round_trips_forward_dynamics_and_gives_the_reactions():
+    s = mb.System("arm", gravity=(0, 0, -9.81))
+    s.add_body("upper", mass=2.0, com=(0.2, 0, 0), inertia=[0.01, 0.03, 0.03])
+    s.add_joint("shoulder", "revolute", parent="ground", child="upper", axis="y")
+    s.add_body("fore", mass=1.0, com=(0.15, 0, 0), inertia=[0.005, 0.01, 0.01])
+    s.add_joint("elbow", "revolute", parent="upper", child="fore", axis="y",
+                position=(0.4, 0, 0))
+    model = s.compile()
+    rng = np.random.default_rng(4)
+    q, u = rng.uniform(-1, 1, 2), rng.uniform(-1, 1, 2)
+    # free motion: zero efforts, and the reactions of the forward solution
+    ud = model.forward_dynamics(q, u)
+    efforts, reac = model.inverse_dynamics(q, u, ud)
+    assert np.abs(list(efforts.values())).max() < 1e-12
+    ref = model.reactions(q, u)
+    for j in ref:
+        assert np.abs(reac[j][0] - ref[j][0]).max() < 1e-10
+    # a prescribed acceleration: the efforts, applied as loads, reproduce it
+    want = np.array([0.7, -1.3])
+    efforts, reac = model.inverse_dynamics(q, u, want)
+    s.add_load("tau_s", "upper", moment=(0, efforts["shoulder_dot"], 0))
+    s.add_load("tau_e", "fore", moment=(0, efforts["elbow_dot"], 0))
+    s.add_load("tau_e_back", "upper", moment=(0, -efforts["elbow_dot"], 0))
+    assert s.compile().forward_dynamics(q, u) == pytest.approx(want, rel=1e-10)
+    # the elbow's reaction moment about its axis is the elbow effort
+    axis = model.kinematics(q).R[1] @ np.array([0, 1.0, 0])
+    assert reac["elbow"][1] @ axis == pytest.approx(efforts["elbow_dot"], rel=1e-10)
+
+
+def test_inverse_dynamics_along_a_prescribed_trajectory():
+    """A pendulum made to follow theta = A sin(w t): the torque is m l^2 theta'' +
+    m g l sin(theta) (the closed form of a point mass at l)."""
+    model = pendulum()
+    t = np.linspace(0, 2, 2001)
+    A, w = 0.3, 2.0
+    th = A * np.sin(w * t)
+    thd = A * w * np.cos(w * t)
+    efforts, reac = model.inverse_dynamics_along(t, th[:, None], thd[:, None])
+    exact = -A * w * w * np.sin(w * t) + 9.81 * np.sin(th)    # m = l = 1
+    # the effort about the joint axis y: sign of the axis' sense
+    assert np.abs(efforts[2:-2, 0] - exact[2:-2]).max() < 1e-5
+    assert reac["theta"].shape == (2001, 6)
