@@ -363,6 +363,17 @@ class Model:
             return default
         if isinstance(values, dict):
             for k, val in values.items():
+                if k not in index and k in self._joint and np.ndim(val) == 1:
+                    # a joint's name: all its coordinates (or speeds) at once, e.g. a
+                    # spherical joint's quaternion from mbdyn.rotations
+                    joint = self._joint[k]
+                    names = joint.coordinates if what == "coordinate" else joint.speeds
+                    if len(val) != len(names) or any(n not in index for n in names):
+                        raise ModelError(f"joint {k!r}: give its {len(names)} {what}s "
+                                         f"({', '.join(names)}), got {len(val)} values")
+                    for n, v in zip(names, val):
+                        default[index[n]] = float(v)
+                    continue
                 if k not in index:
                     raise ModelError(f"unknown {what} {k!r}; the model's {what}s are "
                                      f"{', '.join(index) or '(none)'}")
@@ -429,7 +440,13 @@ class Model:
         if self._laws:
             self._fill_laws(q, u, t)
         for name, row, fn in self._load_functions:
-            val = np.asarray(fn(t, q, u), dtype=float).reshape(-1)
+            try:
+                val = np.asarray(fn(t, q, u), dtype=float).reshape(-1)
+            except (ModelError, NonFiniteError, SingularMassMatrixError):
+                raise
+            except Exception as exc:
+                raise ModelError(f"load {name!r}: its function raised {type(exc).__name__}: "
+                                 f"{exc} (at t={t:.6g})") from exc
             if val.shape != (3,):
                 raise ModelError(f"load {name!r}: its function returned {val.size} values at "
                                  f"t={t}; it must return three")

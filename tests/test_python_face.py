@@ -127,3 +127,46 @@ def test_inverse_dynamics_along_a_prescribed_trajectory():
     # the effort about the joint axis y: sign of the axis' sense
     assert np.abs(efforts[2:-2, 0] - exact[2:-2]).max() < 1e-5
     assert reac["theta"].shape == (2001, 6)
+
+
+def test_rotation_helpers_for_quaternion_initial_states():
+    from mbdyn import rotations as rot
+    rng = np.random.default_rng(8)
+    for _ in range(5):
+        angles = rng.uniform(-2, 2, 3)
+        q = rot.from_euler(angles, "ZXZ")
+        # against the product of the elementary rotations about moving axes
+        def Rk(k, a):
+            c, s = np.cos(a), np.sin(a)
+            i, j = (k + 1) % 3, (k + 2) % 3
+            R = np.eye(3)
+            R[i, i] = R[j, j] = c
+            R[i, j], R[j, i] = -s, s
+            return R
+        R = Rk(2, angles[0]) @ Rk(0, angles[1]) @ Rk(2, angles[2])
+        assert rot.to_matrix(q) == pytest.approx(R, abs=1e-14)
+        assert rot.from_matrix(R) == pytest.approx(q * np.sign(q[0]), abs=1e-14)
+        w = rng.normal(size=3)
+        assert rot.parent_rates(q, rot.body_rates(q, w)) == pytest.approx(w, abs=1e-14)
+    assert rot.from_axis_angle("z", np.pi / 2) == pytest.approx(
+        [np.cos(np.pi / 4), 0, 0, np.sin(np.pi / 4)])
+    # the spherical pendulum tilted by 0.3 about x, spun at 2 rad/s about the world z
+    s = mb.System("sphere")
+    s.add_body("bob", mass=1.0, com=(0, 0, -1), inertia=[0.01] * 3)
+    s.add_joint("ball", "spherical", parent="ground", child="bob")
+    model = s.compile()
+    q = rot.from_axis_angle("x", 0.3)
+    q0 = model.q_vector({"ball": q})
+    u0 = model.u_vector({"ball": rot.body_rates(q, [0, 0, 2.0])})
+    kin = model.kinematics(q0, u0)
+    assert kin.w[0] == pytest.approx([0, 0, 2.0], abs=1e-14)
+
+
+def test_an_exception_in_a_load_function_names_the_load():
+    s = mb.System("pendulum", gravity=(0, 0, -9.81))
+    s.add_body("bob", mass=1.0, com=(0, 0, -1.0))
+    s.add_joint("theta", "revolute", parent="ground", child="bob", axis="y")
+    s.add_load("push", "bob", force=lambda t, q, u: (1.0 / 0.0, 0, 0))
+    with pytest.raises(mb.ModelError, match=r"load 'push': its function raised "
+                                            r"ZeroDivisionError"):
+        s.compile().forward_dynamics([0.1], [0.0])
