@@ -65,6 +65,47 @@ class Result:
     def __len__(self):
         return len(self.t)
 
+    def to_csv(self, path):
+        """Write the results to ``path`` as CSV with named columns (``t``, coordinates,
+        speeds, then the energies, reactions, drive efforts and points computed), the same
+        columns as ``mbdyn run --out``; written whole or not at all."""
+        import io as _io
+        names = ["t"] + list(self.coordinates) + list(self.speeds)
+        cols = [self.t[:, None], self.q, self.u]
+        if self.energy is not None:
+            for key, arr in self.energy.items():
+                names.append(f"energy_{key}")
+                cols.append(np.asarray(arr)[:, None])
+        if self.reactions is not None:
+            for j, arr in self.reactions.items():
+                names += [f"reaction_{j}_{c}" for c in ("Fx", "Fy", "Fz", "Mx", "My", "Mz")]
+                cols.append(np.asarray(arr))
+        if self.drive_efforts:
+            for j, arr in self.drive_efforts.items():
+                names.append(f"effort_{j}")
+                cols.append(np.asarray(arr)[:, None])
+        if self.points:
+            for p, arr in self.points.items():
+                names += [f"point_{p}_{a}" for a in "xyz"]
+                cols.append(np.asarray(arr))
+        table = np.hstack([np.asarray(c, float).reshape(len(self.t), -1) for c in cols])
+        buf = _io.StringIO()
+        buf.write(",".join(names) + "\n")
+        np.savetxt(buf, table, delimiter=",", fmt="%.17g")
+        import os
+        import tempfile
+        directory = os.path.dirname(os.path.abspath(path))
+        fd, tmp = tempfile.mkstemp(prefix=".result.", suffix=".csv", dir=directory)
+        try:
+            with os.fdopen(fd, "w") as fh:
+                fh.write(buf.getvalue())
+            os.replace(tmp, path)
+        except BaseException:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+            raise
+        return path
+
     def __getitem__(self, name):
         if name in self.model.coordinates:
             return self.q[:, self.model.coordinate_index(name)]
@@ -79,8 +120,9 @@ class Result:
         return (f"<Result {self.model.name!r}: {len(self.t)} samples, t = {self.t[0]:g} .. "
                 f"{self.t[-1]:g}, events {self.events}>")
 
-    def compute_outputs(self, outputs=(), points=None, method="newton-euler"):
-        """Evaluate reactions, energies and point trajectories along the stored motion."""
+    def compute_outputs(self, outputs=(), points=None, method="newton-euler", frame="world"):
+        """Evaluate reactions (``frame``: ``"world"`` or ``"child"`` components), energies
+        and point trajectories along the stored motion."""
         model = self.model
         unknown = set(outputs) - set(OUTPUTS)
         if unknown:
@@ -90,7 +132,8 @@ class Result:
             reac = {j: np.empty((n, 6)) for j in model.joints}
             efforts = {j: np.empty(n) for j in model.driven_joints}
             for k in range(n):
-                r = model.reactions(self.q[k], self.u[k], self.t[k], method=method)
+                r = model.reactions(self.q[k], self.u[k], self.t[k], method=method,
+                                    frame=frame)
                 for j, (f, m) in r.items():
                     reac[j][k, :3] = f
                     reac[j][k, 3:] = m
@@ -244,6 +287,7 @@ DEFAULTS = {"integrator": "DOP853", "rtol": 1e-9, "atol": 1e-12, "method": "jour
 def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["integrator"],
              rtol=DEFAULTS["rtol"], atol=DEFAULTS["atol"], dt=None, method=DEFAULTS["method"], events=(), t_eval=None, max_step=np.inf,
              outputs=(), points=None, progress=None, singularity_threshold=1e-3,
+             reactions_frame="world",
              compiled_loop=True):
     """Integrate ``model`` (a compiled ``Model``, or a ``System`` to compile) from ``t0``
     to ``t_end``.
@@ -256,7 +300,9 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     ``method``: ``"jourdain"``, ``"newton-euler"`` or ``"symbolic"`` (the closed-form
     equations compiled by ``mbdyn.symbolic.compiled_rhs``).  ``events``: ``Event``s.
     ``t_eval``: output times (default every accepted step).  ``outputs``: any of ``"reactions"``,
-    ``"energy"``; ``points``: ``{name: (frame, offset)}``.  ``progress``: optional callable
+    ``"energy"``; ``points``: ``{name: (frame, offset)}``; ``reactions_frame``:
+    ``"world"`` or ``"child"`` (the child frame's components, as the textbook writes
+    reactions).  ``progress``: optional callable
     ``progress(t)`` called after each step.  ``singularity_threshold``: stop when an
     Euler-angle joint comes this close to its singularity (see ``Model.euler_singularity``).
     ``compiled_loop``: run fixed-step schemes in compiled stretches when the model allows
@@ -329,7 +375,7 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
         raise SimulationError(failure, result)
     result.stats["status"] = "ok"
     if outputs or points:
-        result.compute_outputs(outputs, points, method="newton-euler")
+        result.compute_outputs(outputs, points, method="newton-euler", frame=reactions_frame)
     return result
 
 

@@ -2,8 +2,12 @@
 import numpy as np
 import pytest
 
+from pathlib import Path
+
 import mbdyn as mb
 from mbdyn.io.loader import DEFAULT_SIMULATION
+
+ROOT = Path(__file__).resolve().parent.parent
 
 
 def pendulum():
@@ -170,3 +174,28 @@ def test_an_exception_in_a_load_function_names_the_load():
     with pytest.raises(mb.ModelError, match=r"load 'push': its function raised "
                                             r"ZeroDivisionError"):
         s.compile().forward_dynamics([0.1], [0.0])
+
+
+def test_python_matches_files_inertia_about_reaction_frame_and_csv(tmp_path):
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", mb.ModelWarning)
+        scene = mb.load_model(ROOT / "models/top.toml", case="a")
+        s = mb.System("top", gravity=(0, 0, -9.81))
+        s.add_body("top", mass=0.582, com=(0, 0, 0.0558),
+                   inertia=[0.00209393, 0.00209393, 0.0022058], inertia_about="origin")
+    assert s.bodies["top"].inertia == pytest.approx(scene.model.body("top").inertia,
+                                                    rel=1e-12)
+    model = pendulum()
+    res = mb.simulate(model, 0.5, {"theta": 0.3}, outputs=("reactions", "energy"),
+                      reactions_frame="child")
+    F_child = res.reactions["theta"][:, :3]
+    kin = model.kinematics(res.q[-1])
+    world = model.reactions(res.q[-1], res.u[-1], res.t[-1])["theta"][0]
+    assert kin.R[0] @ F_child[-1] == pytest.approx(world, rel=1e-9)
+    path = tmp_path / "r.csv"
+    res.to_csv(path)
+    header = path.read_text().splitlines()[0].split(",")
+    assert header[:3] == ["t", "theta", "theta_dot"] and "energy_balance" in header
+    data = np.loadtxt(path, delimiter=",", skiprows=1)
+    assert np.array_equal(data[:, 1], res["theta"])
