@@ -784,6 +784,20 @@ class Model:
                            self._r, self._w, self._v)
         return float(T), float(V)
 
+    def momentum(self, q, u, t=0.0):
+        """Linear momentum ``sum m v_G`` and angular momentum about the world origin
+        ``sum (r_G x m v_G + I_G w)`` of all bodies, world components: ``(p, L)``."""
+        kin = self.kinematics(q, u, t=t)
+        p = np.zeros(3)
+        L = np.zeros(3)
+        for i in range(self.n_frames):
+            m = self._mass[i]
+            R = kin.R[i]
+            IG = R @ self._inertia[i] @ R.T
+            p += m * kin.v_com[i]
+            L += np.cross(kin.r_com[i], m * kin.v_com[i]) + IG @ kin.w[i]
+        return p, L
+
     def element_energy(self, q, u, t=0.0):
         """Force elements' ``(potential energy, non-conservative power)``: the energy stored
         in springs and contacts, and the power dampers, friction, bushings and bearings

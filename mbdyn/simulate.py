@@ -25,7 +25,7 @@ ADAPTIVE = {"RK45": integrate.RK45, "RK23": integrate.RK23, "DOP853": integrate.
             "Radau": integrate.Radau, "BDF": integrate.BDF, "LSODA": integrate.LSODA}
 FIXED_STEP = ("euler", "semi-implicit-euler", "rk4", "implicit-midpoint")
 INTEGRATORS = tuple(ADAPTIVE) + FIXED_STEP
-OUTPUTS = ("reactions", "energy")
+OUTPUTS = ("reactions", "energy", "momentum")
 
 
 class Result:
@@ -53,6 +53,7 @@ class Result:
         self.energy = None
         self.points = None
         self.drive_efforts = None
+        self.momentum = None
 
     @property
     def coordinates(self):
@@ -149,6 +150,12 @@ class Result:
                         np.abs(self.energy["dissipated"]).max(),
                         np.abs(self.energy["work"]).max(), 1e-300)
             self.stats["energy_drift"] = float(np.abs(E - E[0]).max() / scale)
+        if "momentum" in outputs:
+            lin = np.empty((n, 3))
+            ang = np.empty((n, 3))
+            for k in range(n):
+                lin[k], ang[k] = model.momentum(self.q[k], self.u[k], self.t[k])
+            self.momentum = {"linear": lin, "angular": ang}
         if points:
             names = list(points)
             specs = [points[p] for p in names]
