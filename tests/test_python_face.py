@@ -228,3 +228,18 @@ def test_info_shows_a_joints_orientation(tmp_path):
     r = subprocess.run([sys.executable, "-m", "mbdyn", "info", str(path)],
                        capture_output=True, text=True, cwd=ROOT)
     assert "turned by quaternion [0.707107, 0, 0, 0.707107]" in r.stdout, r.stdout
+
+
+def test_derive_substitutes_by_name_or_plain_symbol():
+    import sympy
+    s = mb.System("double pendulum", gravity=(0, -9.81, 0))
+    s.add_body("m1", mass=1.0, com=(0, -1, 0))
+    s.add_joint("theta1", "revolute", parent="ground", child="m1", axis="z")
+    s.add_body("m2", mass=1.0, com=(0, -1, 0))
+    s.add_joint("theta2", "revolute", parent="m1", child="m2", axis="z", position=(0, -1, 0))
+    d = mb.derive(s.compile())
+    flat = d.subs({sympy.Symbol("theta2"): 0, "theta2_dot": 0})
+    assert flat.mass_matrix == sympy.Matrix([[5, 2], [2, 1]])     # cos(0) = 1
+    assert "theta2" not in {x.name for x in flat.forcing.free_symbols}
+    with pytest.raises(mb.ModelError, match="'theta3' is not a name"):
+        d.subs({"theta3": 0})
