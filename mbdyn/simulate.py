@@ -330,8 +330,27 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
         raise ModelError(f"unknown method {method!r}; use 'jourdain', 'newton-euler' or "
                          "'symbolic'")
     t0, t_end = float(t0), float(t_end)
+    if not (np.isfinite(t0) and np.isfinite(t_end)):
+        raise ModelError(f"t0 and t_end must be finite, got {t0} and {t_end}")
     if not t_end > t0:
         raise ModelError(f"t_end ({t_end}) must be greater than t0 ({t0})")
+    for name, value in (("rtol", rtol), ("atol", atol)):
+        if not (np.isfinite(value) and value > 0):
+            raise ModelError(f"{name} must be a positive number, got {value!r}")
+    if not max_step > 0:
+        raise ModelError(f"max_step must be positive, got {max_step!r}")
+    if t_eval is not None:
+        t_eval = np.asarray(t_eval, dtype=float).reshape(-1)
+        if not np.all(np.isfinite(t_eval)):
+            raise ModelError("t_eval holds NaN or infinite times; give finite output times")
+        if np.any(np.diff(t_eval) <= 0):
+            raise ModelError("t_eval must increase strictly (sorted, no repeats)")
+        outside = t_eval[(t_eval < t0 - 1e-12 * max(1.0, abs(t0)))
+                         | (t_eval > t_end + 1e-12 * max(1.0, abs(t_end)))]
+        if outside.size:
+            raise ModelError(f"t_eval has times outside t0..t_end = {t0:g}..{t_end:g} (e.g. "
+                             f"{outside[0]:g}); they would be dropped -- raise t_end or remove "
+                             "them")
     q = model.q_vector(None if q0 is None else (dict(q0) if isinstance(q0, dict) else q0)).copy()
     u = model.u_vector(None if u0 is None else (dict(u0) if isinstance(u0, dict) else u0)).copy()
     if not (np.all(np.isfinite(q)) and np.all(np.isfinite(u))):

@@ -243,3 +243,16 @@ def test_derive_substitutes_by_name_or_plain_symbol():
     assert "theta2" not in {x.name for x in flat.forcing.free_symbols}
     with pytest.raises(mb.ModelError, match="'theta3' is not a name"):
         d.subs({"theta3": 0})
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"t_eval": [0.0, 0.5, 3.0]}, "outside t0..t_end"),
+    ({"t_eval": [0.2, 0.1]}, "must increase"),
+    ({"t_eval": [0.1, float("nan")]}, "NaN"),
+    ({"rtol": 0.0}, "rtol must be a positive"),
+    ({"atol": -1.0}, "atol must be a positive"),
+    ({"max_step": 0.0}, "max_step must be positive"),
+])
+def test_bad_simulate_arguments_are_refused_not_ignored(kwargs, message):
+    with pytest.raises(mb.ModelError, match=message):
+        mb.simulate(pendulum(), 1.0, {"theta": 0.1}, **kwargs)
