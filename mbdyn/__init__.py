@@ -4,7 +4,7 @@ Assemble bodies, frames and joints into a tree (``System``), compile it to a ``M
 evaluate kinematics, Jacobians, the Newton-Euler-Jourdain form ``M(q) u' = f`` or the
 Newton-Euler system with reactions, and integrate with ``simulate``.
 """
-from . import effects, forces, inertia
+from . import effects, forces, inertia, rotations
 from .compile import Kinematics, Model
 from .elements import t
 from .errors import (ModelError, ModelWarning, NonFiniteError, SimulationError,
@@ -30,6 +30,6 @@ __all__ = ["System", "Model", "Kinematics", "Result", "Event", "simulate", "iner
            "GROUND", "INTEGRATORS", "FIXED_STEP", "ModelError", "ModelWarning",
            "NonFiniteError", "SimulationError", "SingularityWarning",
            "SingularMassMatrixError", "load_model", "Scene", "ModelFileError", "derive",
-           "forces", "effects", "equilibrium", "linearize", "modes", "campbell",
+           "forces", "effects", "rotations", "equilibrium", "linearize", "modes", "campbell",
            "Equilibrium", "EquilibriumError", "Linearization", "Modes", "Campbell",
            "sweep", "SweepResult"]

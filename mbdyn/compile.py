@@ -363,6 +363,17 @@ class Model:
             return default
         if isinstance(values, dict):
             for k, val in values.items():
+                if k not in index and k in self._joint and np.ndim(val) == 1:
+                    # a joint's name: all its coordinates (or speeds) at once, e.g. a
+                    # spherical joint's quaternion from mbdyn.rotations
+                    joint = self._joint[k]
+                    names = joint.coordinates if what == "coordinate" else joint.speeds
+                    if len(val) != len(names) or any(n not in index for n in names):
+                        raise ModelError(f"joint {k!r}: give its {len(names)} {what}s "
+                                         f"({', '.join(names)}), got {len(val)} values")
+                    for n, v in zip(names, val):
+                        default[index[n]] = float(v)
+                    continue
                 if k not in index:
                     raise ModelError(f"unknown {what} {k!r}; the model's {what}s are "
                                      f"{', '.join(index) or '(none)'}")
@@ -429,7 +440,13 @@ class Model:
         if self._laws:
             self._fill_laws(q, u, t)
         for name, row, fn in self._load_functions:
-            val = np.asarray(fn(t, q, u), dtype=float).reshape(-1)
+            try:
+                val = np.asarray(fn(t, q, u), dtype=float).reshape(-1)
+            except (ModelError, NonFiniteError, SingularMassMatrixError):
+                raise
+            except Exception as exc:
+                raise ModelError(f"load {name!r}: its function raised {type(exc).__name__}: "
+                                 f"{exc} (at t={t:.6g})") from exc
             if val.shape != (3,):
                 raise ModelError(f"load {name!r}: its function returned {val.size} values at "
                                  f"t={t}; it must return three")
@@ -686,6 +703,57 @@ class Model:
                    for i, (name, (f, m)) in enumerate(out.items())}
         return out
 
+    def inverse_dynamics(self, q, u, u_dot, t=0.0, frame="world"):
+        """The efforts and reactions that make the motion ``(q, u, u')``: returns
+        ``(efforts, reactions)`` -- ``efforts`` ``{speed name: generalized force}`` the
+        actuators must add on each free speed, ``Q = M u' - f`` (a torque on a revolute
+        joint's speed, a force on a prismatic one), and ``reactions`` ``{joint: (F, M)}``
+        as ``Model.reactions`` gives them, the joints transmitting those efforts too."""
+        q, u = self._state(q, u)
+        ud = np.asarray(u_dot, dtype=float)
+        if ud.shape != (self.nu,):
+            raise ModelError(f"model {self.name!r}: u_dot needs {self.nu} values, got "
+                             f"{ud.size}")
+        M = self.mass_matrix(q, t)
+        f = self.forcing(q, u, t)
+        Q = M @ ud - f
+        self._kinematics_kernel(q, u, t, ud)
+        self._drop_velocity_products()
+        w = np.empty((self.n_frames, 6))
+        kd.joint_wrenches(self._mass, self._com, self._inertia, self._parent, self._R,
+                          self._r, self._w, self._alpha, self._a, self._F, self._N, w)
+        reactions = {name: (w[i, :3].copy(), w[i, 3:].copy())
+                     for i, name in enumerate(self.joints)}
+        if frame == "child":
+            reactions = {name: (self._R[i].T @ fo, self._R[i].T @ mo)
+                         for i, (name, (fo, mo)) in enumerate(reactions.items())}
+        elif frame != "world":
+            raise ModelError(f"unknown frame {frame!r} for reactions; use 'world' or 'child'")
+        return dict(zip(self.speeds, Q.tolist())), reactions
+
+    def inverse_dynamics_along(self, t, q, u, u_dot=None, frame="world"):
+        """``inverse_dynamics`` along a trajectory: ``t`` (n,), ``q`` (n, nq), ``u``
+        (n, nu) and ``u_dot`` (n, nu; default the time derivative of ``u`` by second-order
+        finite differences, ``numpy.gradient``).  Returns ``(efforts (n, nu), {joint:
+        (n, 6)})`` -- force then moment, as ``reactions``."""
+        t = np.asarray(t, dtype=float)
+        q = np.asarray(q, dtype=float).reshape(len(t), self.nq)
+        u = np.asarray(u, dtype=float).reshape(len(t), self.nu)
+        if u_dot is None:
+            if len(t) < 3:
+                raise ModelError("inverse_dynamics_along: give u_dot, or at least three "
+                                 "samples to differentiate u")
+            u_dot = np.gradient(u, t, axis=0, edge_order=2)
+        u_dot = np.asarray(u_dot, dtype=float).reshape(len(t), self.nu)
+        efforts = np.empty((len(t), self.nu))
+        reactions = {j: np.empty((len(t), 6)) for j in self.joints}
+        for k in range(len(t)):
+            e, r = self.inverse_dynamics(q[k], u[k], u_dot[k], t[k], frame)
+            efforts[k] = list(e.values())
+            for j, (fo, mo) in r.items():
+                reactions[j][k, :3], reactions[j][k, 3:] = fo, mo
+        return efforts, reactions
+
     def drive_efforts(self, q, u, t=0.0):
         """Force or torque each driven joint needs to impose its motion: ``{joint: value}``
         (the reaction component along the joint axis, in the axis' sense)."""
@@ -715,6 +783,20 @@ class Model:
         T, V = kd.energies(self._mass, self._com, self._inertia, self.gravity, self._R,
                            self._r, self._w, self._v)
         return float(T), float(V)
+
+    def momentum(self, q, u, t=0.0):
+        """Linear momentum ``sum m v_G`` and angular momentum about the world origin
+        ``sum (r_G x m v_G + I_G w)`` of all bodies, world components: ``(p, L)``."""
+        kin = self.kinematics(q, u, t=t)
+        p = np.zeros(3)
+        L = np.zeros(3)
+        for i in range(self.n_frames):
+            m = self._mass[i]
+            R = kin.R[i]
+            IG = R @ self._inertia[i] @ R.T
+            p += m * kin.v_com[i]
+            L += np.cross(kin.r_com[i], m * kin.v_com[i]) + IG @ kin.w[i]
+        return p, L
 
     def element_energy(self, q, u, t=0.0):
         """Force elements' ``(potential energy, non-conservative power)``: the energy stored

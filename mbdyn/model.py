@@ -76,12 +76,27 @@ class System:
             raise ModelError(f"body/frame {name!r}: the name is already used by {what}; "
                              "choose another name")
 
-    def add_body(self, name, mass=0.0, com=(0, 0, 0), inertia=None, shape=None):
+    def add_body(self, name, mass=0.0, com=(0, 0, 0), inertia=None, shape=None,
+                 inertia_about="com"):
         """A rigid body: ``mass``, centre of mass ``com`` in body components (from the
         frame origin), ``inertia`` about the centre of mass in body axes -- ``None``/0 for a
         particle, three principal moments, or a 3x3 tensor (see ``mbdyn.inertia``).
-        ``shape``: how pictures draw it (``mbdyn.elements.make_shape``)."""
+        ``shape``: how pictures draw it (``mbdyn.elements.make_shape``).
+        ``inertia_about="origin"``: the inertia is given about the frame origin instead (as
+        the textbook's top data are); it is moved to the centre of mass by the parallel-axis
+        theorem, ``I_G = I_O - m (|c|^2 E - c c^T)``."""
         self._check_new_frame(name)
+        if inertia_about not in ("com", "origin"):
+            raise ModelError(f"body {name!r}: inertia_about must be 'com' or 'origin', got "
+                             f"{inertia_about!r}")
+        if inertia_about == "origin":
+            if inertia is None:
+                raise ModelError(f"body {name!r}: inertia_about='origin' needs an inertia")
+            I_O = sympy.Matrix(np.diag(inertia) if np.ndim(inertia) == 1 else inertia)
+            c = sympy.Matrix(list(com))
+            I_G = I_O - mass * ((c.T * c)[0, 0] * sympy.eye(3) - c * c.T)
+            inertia = [[float(v) if not getattr(v, "free_symbols", None) else v
+                        for v in I_G.row(r)] for r in range(3)]
         self.graph.add_node(name, body=make_body(name, mass, com, inertia, self.parameters,
                                                  shape))
         return name

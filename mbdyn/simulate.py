@@ -25,7 +25,7 @@ ADAPTIVE = {"RK45": integrate.RK45, "RK23": integrate.RK23, "DOP853": integrate.
             "Radau": integrate.Radau, "BDF": integrate.BDF, "LSODA": integrate.LSODA}
 FIXED_STEP = ("euler", "semi-implicit-euler", "rk4", "implicit-midpoint")
 INTEGRATORS = tuple(ADAPTIVE) + FIXED_STEP
-OUTPUTS = ("reactions", "energy")
+OUTPUTS = ("reactions", "energy", "momentum")
 
 
 class Result:
@@ -53,6 +53,7 @@ class Result:
         self.energy = None
         self.points = None
         self.drive_efforts = None
+        self.momentum = None
 
     @property
     def coordinates(self):
@@ -64,6 +65,47 @@ class Result:
 
     def __len__(self):
         return len(self.t)
+
+    def to_csv(self, path):
+        """Write the results to ``path`` as CSV with named columns (``t``, coordinates,
+        speeds, then the energies, reactions, drive efforts and points computed), the same
+        columns as ``mbdyn run --out``; written whole or not at all."""
+        import io as _io
+        names = ["t"] + list(self.coordinates) + list(self.speeds)
+        cols = [self.t[:, None], self.q, self.u]
+        if self.energy is not None:
+            for key, arr in self.energy.items():
+                names.append(f"energy_{key}")
+                cols.append(np.asarray(arr)[:, None])
+        if self.reactions is not None:
+            for j, arr in self.reactions.items():
+                names += [f"reaction_{j}_{c}" for c in ("Fx", "Fy", "Fz", "Mx", "My", "Mz")]
+                cols.append(np.asarray(arr))
+        if self.drive_efforts:
+            for j, arr in self.drive_efforts.items():
+                names.append(f"effort_{j}")
+                cols.append(np.asarray(arr)[:, None])
+        if self.points:
+            for p, arr in self.points.items():
+                names += [f"point_{p}_{a}" for a in "xyz"]
+                cols.append(np.asarray(arr))
+        table = np.hstack([np.asarray(c, float).reshape(len(self.t), -1) for c in cols])
+        buf = _io.StringIO()
+        buf.write(",".join(names) + "\n")
+        np.savetxt(buf, table, delimiter=",", fmt="%.17g")
+        import os
+        import tempfile
+        directory = os.path.dirname(os.path.abspath(path))
+        fd, tmp = tempfile.mkstemp(prefix=".result.", suffix=".csv", dir=directory)
+        try:
+            with os.fdopen(fd, "w") as fh:
+                fh.write(buf.getvalue())
+            os.replace(tmp, path)
+        except BaseException:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+            raise
+        return path
 
     def __getitem__(self, name):
         if name in self.model.coordinates:
@@ -79,8 +121,9 @@ class Result:
         return (f"<Result {self.model.name!r}: {len(self.t)} samples, t = {self.t[0]:g} .. "
                 f"{self.t[-1]:g}, events {self.events}>")
 
-    def compute_outputs(self, outputs=(), points=None, method="newton-euler"):
-        """Evaluate reactions, energies and point trajectories along the stored motion."""
+    def compute_outputs(self, outputs=(), points=None, method="newton-euler", frame="world"):
+        """Evaluate reactions (``frame``: ``"world"`` or ``"child"`` components), energies
+        and point trajectories along the stored motion."""
         model = self.model
         unknown = set(outputs) - set(OUTPUTS)
         if unknown:
@@ -90,7 +133,8 @@ class Result:
             reac = {j: np.empty((n, 6)) for j in model.joints}
             efforts = {j: np.empty(n) for j in model.driven_joints}
             for k in range(n):
-                r = model.reactions(self.q[k], self.u[k], self.t[k], method=method)
+                r = model.reactions(self.q[k], self.u[k], self.t[k], method=method,
+                                    frame=frame)
                 for j, (f, m) in r.items():
                     reac[j][k, :3] = f
                     reac[j][k, 3:] = m
@@ -106,6 +150,12 @@ class Result:
                         np.abs(self.energy["dissipated"]).max(),
                         np.abs(self.energy["work"]).max(), 1e-300)
             self.stats["energy_drift"] = float(np.abs(E - E[0]).max() / scale)
+        if "momentum" in outputs:
+            lin = np.empty((n, 3))
+            ang = np.empty((n, 3))
+            for k in range(n):
+                lin[k], ang[k] = model.momentum(self.q[k], self.u[k], self.t[k])
+            self.momentum = {"linear": lin, "angular": ang}
         if points:
             names = list(points)
             specs = [points[p] for p in names]
@@ -244,6 +294,7 @@ DEFAULTS = {"integrator": "DOP853", "rtol": 1e-9, "atol": 1e-12, "method": "jour
 def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["integrator"],
              rtol=DEFAULTS["rtol"], atol=DEFAULTS["atol"], dt=None, method=DEFAULTS["method"], events=(), t_eval=None, max_step=np.inf,
              outputs=(), points=None, progress=None, singularity_threshold=1e-3,
+             reactions_frame="world",
              compiled_loop=True):
     """Integrate ``model`` (a compiled ``Model``, or a ``System`` to compile) from ``t0``
     to ``t_end``.
@@ -256,7 +307,9 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     ``method``: ``"jourdain"``, ``"newton-euler"`` or ``"symbolic"`` (the closed-form
     equations compiled by ``mbdyn.symbolic.compiled_rhs``).  ``events``: ``Event``s.
     ``t_eval``: output times (default every accepted step).  ``outputs``: any of ``"reactions"``,
-    ``"energy"``; ``points``: ``{name: (frame, offset)}``.  ``progress``: optional callable
+    ``"energy"``; ``points``: ``{name: (frame, offset)}``; ``reactions_frame``:
+    ``"world"`` or ``"child"`` (the child frame's components, as the textbook writes
+    reactions).  ``progress``: optional callable
     ``progress(t)`` called after each step.  ``singularity_threshold``: stop when an
     Euler-angle joint comes this close to its singularity (see ``Model.euler_singularity``).
     ``compiled_loop``: run fixed-step schemes in compiled stretches when the model allows
@@ -277,8 +330,27 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
         raise ModelError(f"unknown method {method!r}; use 'jourdain', 'newton-euler' or "
                          "'symbolic'")
     t0, t_end = float(t0), float(t_end)
+    if not (np.isfinite(t0) and np.isfinite(t_end)):
+        raise ModelError(f"t0 and t_end must be finite, got {t0} and {t_end}")
     if not t_end > t0:
         raise ModelError(f"t_end ({t_end}) must be greater than t0 ({t0})")
+    for name, value in (("rtol", rtol), ("atol", atol)):
+        if not (np.isfinite(value) and value > 0):
+            raise ModelError(f"{name} must be a positive number, got {value!r}")
+    if not max_step > 0:
+        raise ModelError(f"max_step must be positive, got {max_step!r}")
+    if t_eval is not None:
+        t_eval = np.asarray(t_eval, dtype=float).reshape(-1)
+        if not np.all(np.isfinite(t_eval)):
+            raise ModelError("t_eval holds NaN or infinite times; give finite output times")
+        if np.any(np.diff(t_eval) <= 0):
+            raise ModelError("t_eval must increase strictly (sorted, no repeats)")
+        outside = t_eval[(t_eval < t0 - 1e-12 * max(1.0, abs(t0)))
+                         | (t_eval > t_end + 1e-12 * max(1.0, abs(t_end)))]
+        if outside.size:
+            raise ModelError(f"t_eval has times outside t0..t_end = {t0:g}..{t_end:g} (e.g. "
+                             f"{outside[0]:g}); they would be dropped -- raise t_end or remove "
+                             "them")
     q = model.q_vector(None if q0 is None else (dict(q0) if isinstance(q0, dict) else q0)).copy()
     u = model.u_vector(None if u0 is None else (dict(u0) if isinstance(u0, dict) else u0)).copy()
     if not (np.all(np.isfinite(q)) and np.all(np.isfinite(u))):
@@ -329,7 +401,7 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
         raise SimulationError(failure, result)
     result.stats["status"] = "ok"
     if outputs or points:
-        result.compute_outputs(outputs, points, method="newton-euler")
+        result.compute_outputs(outputs, points, method="newton-euler", frame=reactions_frame)
     return result
 
 

@@ -182,3 +182,13 @@ def test_mode_shape_animation(tmp_path):
         (mode.shape[1] / mode.shape[0]).real, rel=1e-9)
     n = animate_mode(lin, mode, tmp_path / "mode.gif", period_seconds=1.0, fps=25)
     assert n == int(2 * 25) + 1
+
+
+def test_output_points_leave_trails():
+    from mbdyn.viz.geometry import frames
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", mb.ModelWarning)
+        res = mb.load_model(ROOT / "models/top.toml", case="a").simulate(t_end=0.5)
+    scenes = frames(res, np.linspace(0, 0.5, 11))
+    trail = scenes[-1].trails["point G"]
+    assert len(trail) == 11 and trail[-1] == pytest.approx(res.points["G"][-1], abs=1e-12)

@@ -16,6 +16,8 @@ TOP = str(MODELS / "top.toml")
 BEAD = str(MODELS / "bead_on_rod.toml")
 
 SUMMARY_TYPES = {"model": str, "case": (str, type(None)), "t_final": float, "q": dict,
+                 "reactions": (dict, type(None)), "drive_efforts": (dict, type(None)),
+                 "points": (dict, type(None)),
                  "u": dict, "events": list, "energy": (dict, type(None)), "stats": dict}
 STATS_TYPES = {"integrator": str, "method": str, "steps": int, "rhs_evaluations": int,
                "wall_time_s": float}

@@ -502,7 +502,6 @@ def test_force_law_as_an_expression_matches_the_same_linear_spring():
     import sympy
     x, v = sympy.symbols("x v")
     lin = oscillator(k=800.0, c=4.0).compile()
-    s = oscillator(k=None, c=0.0) if False else None
     s = mb.System("law", gravity=(0, 0, -9.81), parameters={"k": 800.0, "c": 4.0})
     k, c = s.symbols("k c")
     s.add_body("block", mass=2.0)
@@ -533,7 +532,7 @@ def test_progressive_law_from_a_model_file_and_a_python_function(tmp_path):
     q = np.array([0.2])
     f = model.forcing(q, [0.0])
     assert f[0] == pytest.approx(-(800 * 0.2 + 4 * 800 * 0.2 ** 3 / 0.25), rel=1e-12)
-    s = oscillator(c=0.0, k=None) if False else mb.System("fn", gravity=(0, 0, 0))
+    s = mb.System("fn", gravity=(0, 0, 0))
     s.add_body("block", mass=2.0)
     s.add_joint("x", "prismatic", parent="ground", child="block", axis="x")
     s.add_force("stop", "joint-spring-damper", joint="x",

@@ -52,6 +52,9 @@ def describe(scene):
             entry["sequence"] = "".join("XYZ"[k] for k in j.sequence)
         if np.any(j.position):
             entry["position"] = j.position.tolist()
+        if np.abs(j.orientation - np.eye(3)).max() > 0:
+            from ..rotations import from_matrix
+            entry["orientation"] = from_matrix(j.orientation).tolist()
         if j.drive is not None:
             entry["drive"] = str(spec["drive"])
             drives.append({"joint": j.name, "coordinate": j.coordinates[0],
@@ -116,6 +119,8 @@ def info(args):
             extra += f" {j['sequence']}"
         if "position" in j:
             extra += f" at {_text(j['position'])}"
+        if "orientation" in j:
+            extra += f", turned by quaternion {_text(j['orientation'])}"
         what = (f"driven: {j['coordinates'][0]} = {j['drive']}" if j["driven"]
                 else ("coordinates " + ", ".join(j["coordinates"]) if j["coordinates"]
                       else "no coordinates"))

@@ -38,6 +38,8 @@ def summary(scene, result):
         {"model": str, "case": str|null, "t_final": float, "q": {name: float},
          "u": {name: float}, "events": [{"name": str, "t": float}],
          "energy": {"initial": float, "final": float}|null,
+         "reactions": {joint: [Fx, Fy, Fz, Mx, My, Mz]}|null,   (at t_final, as requested)
+         "drive_efforts": {joint: float}|null, "points": {name: [x, y, z]}|null,
          "stats": {"integrator": str, "method": str, "steps": int,
                    "rhs_evaluations": int, "wall_time_s": float}}
     """
@@ -55,6 +57,13 @@ def summary(scene, result):
         "u": {n: _float(v) for n, v in zip(model.speeds, result.u[-1])},
         "events": [{"name": str(n), "t": _float(t)} for n, t in result.events],
         "energy": energy,
+        "reactions": ({j: [_float(v) for v in arr[-1]]
+                       for j, arr in reaction_series(scene, result).items()}
+                      if result.reactions is not None and len(result.t) else None),
+        "drive_efforts": ({j: _float(arr[-1]) for j, arr in result.drive_efforts.items()}
+                          if result.drive_efforts and len(result.t) else None),
+        "points": ({p: [_float(v) for v in arr[-1]] for p, arr in result.points.items()}
+                   if result.points and len(result.t) else None),
         "stats": {"integrator": str(st.get("integrator")), "method": str(st.get("method")),
                   "steps": int(st.get("steps", 0)),
                   "rhs_evaluations": int(st.get("rhs_evaluations", 0)),

@@ -108,6 +108,30 @@ class Derivation:
         """``{name: Symbol}`` of every parameter, coordinate, speed, rate and ``t``."""
         return dict(self.walk.sym.table)
 
+    def subs(self, values):
+        """A copy with ``values`` substituted in the equations (and solutions), keys given
+        as names (``"theta2"``), plain ``sympy.Symbol("theta2")`` or the derivation's own
+        symbols.  The derivation's symbols are real (``Symbol(name, real=True)``), which a
+        plain symbol is not equal to, so ``mass_matrix.subs({Symbol("theta2"): 0})`` would
+        change nothing; this method maps by name, and refuses unknown names."""
+        import dataclasses
+        table = self.walk.sym.table
+        mapping = {}
+        for key, value in dict(values).items():
+            name = key if isinstance(key, str) else getattr(key, "name", None)
+            if name not in table:
+                raise ModelError(f"subs: {key!r} is not a name of this derivation; its names "
+                                 f"are {', '.join(table)}")
+            mapping[table[name]] = value
+        sub = lambda e: e.xreplace(mapping) if hasattr(e, "xreplace") else e  # noqa: E731
+        return dataclasses.replace(
+            self, mass_matrix=sub(self.mass_matrix), forcing=sub(self.forcing),
+            accelerations=None if self.accelerations is None else
+            {k: sub(v) for k, v in self.accelerations.items()},
+            reactions=None if self.reactions is None else
+            {k: (sub(v) if not isinstance(v, (tuple, list)) else type(v)(sub(x) for x in v))
+             for k, v in self.reactions.items()})
+
     # ------------------------------------------------------------------ numbers
     def numeric(self, what="mass_matrix"):
         """A function ``(q, u, t=0, parameters=None)`` -> numpy array of ``mass_matrix``,

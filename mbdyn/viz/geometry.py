@@ -141,18 +141,23 @@ def state_at(result, t):
 
 
 def frames(result, times, trail=90):
-    """``Scene3D`` of every time in ``times``, with the centres of mass' trails over the
+    """``Scene3D`` of every time in ``times``, with the trails of the centres of mass and of
+    the run's output points (``[outputs.points]``) over the
     last ``trail`` frames (3 s of real-time playback: keeps an HTML view's size linear in
     its length)."""
     model = result.model
     geometry = model_geometry(model)
     out = []
     trail_points, trail_length = {}, int(trail)
+    outputs = result.points or {}
     for t in times:
         q, u = state_at(result, t)
         sc = instant(model, geometry, q, u, t)
         for name, pos, _, _ in sc.markers:
             trail_points.setdefault(name, []).append(pos)
+        for name, arr in outputs.items():        # the run's output points leave trails too
+            pos = np.array([np.interp(t, result.t, arr[:, k]) for k in range(3)])
+            trail_points.setdefault("point " + name, []).append(pos)
         sc.trails = {k: np.array(v[-trail_length:]) for k, v in trail_points.items()}
         out.append(sc)
     return out
