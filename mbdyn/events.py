@@ -55,7 +55,7 @@ class EventRecord(tuple):
         return (EventRecord, (self[0], self[1], self.q, self.u, self._names))
 
 
-class _Compiled:
+class CompiledCondition:
     """``g(t, q, u)`` of a sympy condition over the model's names."""
 
     def __init__(self, fn, text):
@@ -107,7 +107,7 @@ def compile_condition(condition, model, name):
     args = [sympy.Symbol(n) for n in ("t",) + model.coordinates + model.speeds]
     g = g.subs({s: sympy.Symbol(s.name) for s in g.free_symbols})
     fn = sympy.lambdify(args, g, modules="numpy")
-    return _Compiled(fn, text), implied
+    return CompiledCondition(fn, text), implied
 
 
 def as_event(e, model):

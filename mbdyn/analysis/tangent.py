@@ -12,17 +12,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..kernels.joints import KIND_CODES
+from ..rotations import product as quaternion_product
 
 SPHERICAL, FREE = KIND_CODES["spherical"], KIND_CODES["free"]
-
-
-def quaternion_product(a, b):
-    w1, x1, y1, z1 = a
-    w2, x2, y2, z2 = b
-    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-                     w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-                     w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-                     w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
 
 
 def rotation_quaternion(theta):

@@ -28,6 +28,7 @@ from ..model import GROUND, System
 from ..simulate import DEFAULTS as SIMULATE_DEFAULTS
 from ..simulate import FIXED_STEP, INTEGRATORS, Event, Result
 from ..simulate import simulate as _simulate
+from ..events import CompiledCondition as _Condition
 from .errors import ModelFileError
 from .expressions import ExpressionError, parse, parse_condition, symbol, to_float
 from .schema import (DIRECTIONS, Checker, _suggest, apply_case, apply_override,
@@ -132,20 +133,6 @@ def load_model(path, case=None, overrides=None, effects=None):
     for message, category in builder.emitted:
         warnings.warn(message, category, stacklevel=2)
     return scene
-
-
-class _Condition:
-    """An event condition ``g(t, q, u)`` compiled from its expression."""
-
-    def __init__(self, fn, text):
-        self.fn = fn
-        self.text = text
-
-    def __call__(self, t, q, u):
-        return float(self.fn(t, *q, *u))
-
-    def __repr__(self):
-        return f"<condition {self.text!r}>"
 
 
 class Scene:

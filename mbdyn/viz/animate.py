@@ -33,15 +33,9 @@ def up_rotation(model):
 
 
 def check_output(path):
-    ext = os.path.splitext(str(path))[1].lower()
-    if ext not in FORMATS:
-        raise ModelError(f"{path}: unknown animation format {ext or '(none)'!r}; use one of "
-                         f"{', '.join(FORMATS)}")
-    directory = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(directory):
-        raise ModelError(f"{path}: the directory {directory} does not exist")
-    if not os.access(directory, os.W_OK):
-        raise ModelError(f"{path}: cannot write into {directory} (permission denied)")
+    """The extension of a writable animation path; clear errors otherwise."""
+    from .plots import _check_path
+    ext = _check_path(path, FORMATS, "animation")
     if ext == ".mp4":
         try:
             import imageio_ffmpeg  # noqa: F401

@@ -85,16 +85,19 @@ def _expand(names, table):
     return out
 
 
-def _check_path(path):
+def _check_path(path, formats=FORMATS, what="picture"):
+    """The extension of an output path, checked before any work: a known format, an
+    existing, writable directory."""
     ext = os.path.splitext(str(path))[1].lower()
-    if ext not in FORMATS:
-        raise ModelError(f"{path}: unknown picture format {ext or '(none)'!r}; use one of "
-                         f"{', '.join(FORMATS)}")
+    if ext not in formats:
+        raise ModelError(f"{path}: unknown {what} format {ext or '(none)'!r}; use one of "
+                         f"{', '.join(formats)}")
     directory = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(directory):
         raise ModelError(f"{path}: the directory {directory} does not exist")
     if not os.access(directory, os.W_OK):
         raise ModelError(f"{path}: cannot write into {directory} (permission denied)")
+    return ext
 
 
 def _save(fig, path):
