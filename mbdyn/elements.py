@@ -13,7 +13,8 @@ from typing import Callable
 import numpy as np
 import sympy
 
-from .errors import ModelError, ModelWarning
+from .errors import ModelError, ModelWarning, NonFiniteError
+from .names import identifier_problem
 from .kernels.joints import KIND_CODES, NQ, NU
 
 #: The time symbol for drive expressions: ``drive=Omega * mb.t``.
@@ -276,7 +277,8 @@ def make_drive(drive, element, parameters=None):
         if len(drive) != 3 or not all(callable(f) for f in drive):
             raise ModelError(f"{element}: drive must be a sympy expression of mb.t or three "
                              "callables (q(t), q'(t), q''(t))")
-        return Drive(*drive)
+        return Drive(*(_guarded(f, element, what, callable_=True)
+                       for f, what in zip(drive, DRIVE_PARTS)))
     try:
         expr = sympy.Float(drive) if isinstance(drive, (int, float)) else drive
         expr = substitute(expr, parameters or {})
@@ -293,10 +295,34 @@ def make_drive(drive, element, parameters=None):
     tsyms = [s for s in free if s.name == "t"]
     expr = expr.subs({s: t for s in tsyms})
     funcs = [sympy.lambdify(t, e, "math") for e in (expr, expr.diff(t), expr.diff(t, 2))]
+    return Drive(*(_guarded(f, element, what) for f, what in zip(funcs, DRIVE_PARTS)),
+                 expression=expr)
 
-    def as_float(f):
-        return lambda time: float(f(time))
-    return Drive(*(as_float(f) for f in funcs), expression=expr)
+
+DRIVE_PARTS = ("position", "velocity", "acceleration")
+
+
+def _guarded(f, element, what, callable_=False):
+    """``f(t)`` as a float; a value that is undefined or not finite at ``t`` raises
+    ``NonFiniteError`` naming the joint, the drive's part and the time (never a bare
+    ``math domain error``); an exception of a user's function is named, not swallowed."""
+    def value(time):
+        try:
+            v = float(f(time))
+        except (ValueError, ZeroDivisionError, OverflowError) as exc:
+            raise NonFiniteError(f"{element}: the drive's {what} is undefined at t={time:.6g} "
+                                 f"({exc}); give a drive defined over the whole run "
+                                 "(e.g. log(t + 1) rather than log(t))") from None
+        except Exception as exc:
+            if not callable_:
+                raise
+            raise ModelError(f"{element}: the drive's {what} function raised "
+                             f"{type(exc).__name__}: {exc} at t={time:.6g}") from exc
+        if not math.isfinite(v):
+            raise NonFiniteError(f"{element}: the drive's {what} is {v} at t={time:.6g}; give "
+                                 "a drive that stays finite over the whole run")
+        return v
+    return value
 
 
 @dataclass(frozen=True)
@@ -360,9 +386,9 @@ def _default_names(name, kind, coordinates, speeds, element):
     else:
         un = ()
     for n in qn + un:
-        if not isinstance(n, str) or not n.isidentifier():
-            raise ModelError(f"{element}: coordinate/speed name {n!r} must be an identifier "
-                             "(letters, digits, underscore)")
+        problem = identifier_problem(n)
+        if problem:
+            raise ModelError(f"{element}: coordinate/speed name {n!r} {problem}")
     return qn, un
 
 

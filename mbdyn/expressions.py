@@ -18,6 +18,8 @@ import math
 
 import sympy
 
+from . import limits
+
 #: Functions an expression may call: name -> (sympy function, allowed numbers of arguments).
 FUNCTIONS = {
     "sin": (sympy.sin, (1,)), "cos": (sympy.cos, (1,)), "tan": (sympy.tan, (1,)),
@@ -33,9 +35,11 @@ CONSTANTS = {"pi": sympy.pi}
 #: Names a parameter, coordinate or speed may not take.
 RESERVED = frozenset(FUNCTIONS) | frozenset(CONSTANTS) | {"t"}
 
-MAX_LENGTH = 2000          # characters of one expression
-MAX_NODES = 1000           # ast nodes of one expression
-MAX_EXPONENT = 1000        # |exponent| of a numeric power
+MAX_LENGTH = limits.MAX_EXPRESSION_LENGTH      # characters of one expression
+MAX_NODES = limits.MAX_EXPRESSION_NODES        # ast nodes of one expression
+MAX_DEPTH = limits.MAX_EXPRESSION_DEPTH        # nesting of one expression
+MAX_EXPONENT = limits.MAX_EXPONENT             # |exponent| of a power
+MAX_CONSTANT = limits.MAX_CONSTANT             # |value| of any constant part
 
 COMPARISONS = {ast.GtE: ">=", ast.Gt: ">", ast.LtE: "<=", ast.Lt: "<", ast.Eq: "=="}
 
@@ -70,7 +74,56 @@ def symbol(name):
     return sympy.Symbol(name, real=True)
 
 
+#: The same functions on floats, for the value of constant parts and of ``to_float``.
+FLOAT_FUNCTIONS = {
+    "sin": math.sin, "cos": math.cos, "tan": math.tan, "asin": math.asin, "acos": math.acos,
+    "atan": math.atan, "atan2": math.atan2, "sinh": math.sinh, "cosh": math.cosh,
+    "tanh": math.tanh, "sqrt": math.sqrt, "exp": math.exp,
+    "log": lambda x, b=None: math.log(x) if b is None else math.log(x, b),
+    "abs": abs, "sign": lambda x: math.copysign(1.0, x) if x else 0.0, "min": min, "max": max,
+}
+
+
+def _float_call(fname, args):
+    """``FLOAT_FUNCTIONS[fname](*args)``, or the reason it has no finite real value."""
+    try:
+        v = FLOAT_FUNCTIONS[fname](*args)
+    except OverflowError:
+        return None, f"{fname}() overflows (beyond {MAX_CONSTANT:g})"
+    except (ValueError, ZeroDivisionError):
+        shown = ", ".join(f"{a:.6g}" for a in args)
+        if fname == "log" and args[0] == 0:
+            return None, "log(0) is not finite"
+        return None, (f"{fname}({shown}) is not a real number (outside the function's "
+                      "domain)")
+    if isinstance(v, complex) or not math.isfinite(v):
+        return None, f"{fname}() has no finite real value here"
+    return float(v), None
+
+
+def _float_power(a, b):
+    try:
+        v = a ** b
+    except OverflowError:
+        return None, f"the power {a:.6g}**{b:.6g} overflows (beyond {MAX_CONSTANT:g})"
+    except ZeroDivisionError:
+        return None, "zero to a negative power"
+    if isinstance(v, complex):
+        return None, f"{a:.6g}**{b:.6g} is not a real number"
+    if not math.isfinite(v):
+        return None, f"the power {a:.6g}**{b:.6g} overflows (beyond {MAX_CONSTANT:g})"
+    return float(v), None
+
+
 class _Builder:
+    """Builds the sympy expression of a parse tree, node by node.
+
+    ``build`` returns ``(expression, value)``: ``value`` is the float of a constant part
+    (``None`` where a name enters), computed alongside so that a constant that overflows
+    or leaves a function's domain is refused before sympy's exact arithmetic is asked for
+    it (``exp(exp(exp(9)))`` would otherwise cost unbounded time and memory).
+    """
+
     def __init__(self, text, names, comparison):
         self.text = text
         self.names = names
@@ -82,45 +135,61 @@ class _Builder:
         where = f" (at column {col + 1})" if col is not None else ""
         raise ExpressionError(f"cannot read {self.text!r}{where}: {what}")
 
+    def bounded(self, value, node):
+        if value is not None and abs(value) > MAX_CONSTANT:
+            self.fail(f"the number {value:.6g} is too large (the limit is {MAX_CONSTANT:g})",
+                      node)
+        return value
+
     def build(self, node):
         if isinstance(node, ast.Constant):
             v = node.value
             if isinstance(v, bool) or not isinstance(v, (int, float)):
                 self.fail(f"{v!r} is not a number; expressions hold {ALLOWED_SUMMARY}", node)
             if isinstance(v, int):
-                return sympy.Integer(v)
+                if v.bit_length() > 1000:
+                    self.fail(f"the integer is too large (the limit is {MAX_CONSTANT:g})", node)
+                return sympy.Integer(v), self.bounded(float(v), node)
             if not math.isfinite(v):
                 self.fail("the number is not finite", node)
-            return sympy.Float(v)
+            return sympy.Float(v), self.bounded(v, node)
         if isinstance(node, ast.Name):
             return self.name(node)
         if isinstance(node, ast.UnaryOp):
-            if isinstance(node.op, ast.USub):
-                return -self.build(node.operand)
-            if isinstance(node.op, ast.UAdd):
-                return self.build(node.operand)
+            if isinstance(node.op, (ast.USub, ast.UAdd)):
+                e, v = self.build(node.operand)
+                if isinstance(node.op, ast.USub):
+                    return -e, (None if v is None else -v)
+                return e, v
             self.fail("'not' and '~' are not allowed", node)
         if isinstance(node, ast.BinOp):
             hint = _OPERATOR_HINTS.get(type(node.op))
             if hint:
                 self.fail(hint, node)
-            a, b = self.build(node.left), self.build(node.right)
+            (a, va), (b, vb) = self.build(node.left), self.build(node.right)
+            known = va is not None and vb is not None
             if isinstance(node.op, ast.Add):
-                return a + b
+                return a + b, (self.bounded(va + vb, node) if known else None)
             if isinstance(node.op, ast.Sub):
-                return a - b
+                return a - b, (self.bounded(va - vb, node) if known else None)
             if isinstance(node.op, ast.Mult):
-                return a * b
+                return a * b, (self.bounded(va * vb, node) if known else None)
             if isinstance(node.op, ast.Div):
-                if b.is_zero:
+                if b.is_zero or vb == 0:
                     self.fail("division by zero", node)
-                return a / b
+                return a / b, (self.bounded(va / vb, node) if known else None)
             if isinstance(node.op, ast.Pow):
-                if b.is_number and abs(complex(b.evalf(15))) > MAX_EXPONENT:
-                    self.fail(f"exponent {b} is too large (at most {MAX_EXPONENT})", node)
-                if a.is_zero and b.is_number and b.is_negative:
+                if vb is not None and abs(vb) > MAX_EXPONENT:
+                    self.fail(f"exponent {vb:.6g} is too large (at most {MAX_EXPONENT})", node)
+                if (a.is_zero or va == 0) and vb is not None and vb < 0:
                     self.fail("zero to a negative power", node)
-                return a ** b
+                value = None
+                if known:
+                    value, why = _float_power(va, vb)
+                    if why:
+                        self.fail(why, node)
+                    self.bounded(value, node)
+                return a ** b, value
             self.fail("operator not allowed", node)
         if isinstance(node, ast.Call):
             return self.call(node)
@@ -133,15 +202,22 @@ class _Builder:
     def name(self, node):
         n = node.id
         if n in CONSTANTS:
-            return CONSTANTS[n]
+            return CONSTANTS[n], float(CONSTANTS[n])
         if n in FUNCTIONS:
             self.fail(f"{n} is a function; call it, e.g. {n}(x)", node)
+        if not n.isascii():
+            self.fail(f"the name {n!r} has characters outside ASCII (a look-alike of "
+                      f"{_ascii_hint(n)!r}?); names are ASCII letters, digits and '_'", node)
         if self.names is None:          # syntax check only
             self.used.add(n)
-            return symbol(n)
+            return symbol(n), None
         if n in self.names:
             self.used.add(n)
-            return self.names[n]
+            e = self.names[n]
+            value = None
+            if getattr(e, "is_Number", False) or isinstance(e, (int, float)):
+                value = float(e)
+            return e, value
         known = sorted(self.names)
         close = difflib.get_close_matches(n, known + list(CONSTANTS), n=1, cutoff=0.6)
         hint = f" (did you mean {close[0]!r}?)" if close else ""
@@ -164,8 +240,21 @@ class _Builder:
         if len(node.args) not in arities:
             n = " or ".join(str(k) for k in arities[:2]) + (" or more" if len(arities) > 2 else "")
             self.fail(f"{fname}() takes {n} argument(s), got {len(node.args)}", node)
-        args = [self.build(a) for a in node.args]
-        return func(*args)
+        built = [self.build(a) for a in node.args]
+        values = [v for _, v in built]
+        value = None
+        if all(v is not None for v in values):
+            value, why = _float_call(fname, values)
+            if why:
+                self.fail(why, node)
+            self.bounded(value, node)
+        return func(*[e for e, _ in built]), value
+
+
+def _ascii_hint(name):
+    """The ASCII letters a look-alike name stands for (NFKC: full-width, ligatures)."""
+    import unicodedata
+    return unicodedata.normalize("NFKC", name).encode("ascii", "replace").decode()
 
 
 def _parse_tree(text):
@@ -176,6 +265,16 @@ def _parse_tree(text):
                               f"(at most {MAX_LENGTH})")
     if not text.strip():
         raise ExpressionError("empty expression; write a number or an expression such as 'pi/4'")
+    if not text.isascii():
+        # Python's parser would NFKC-normalise a full-width 't' into the name t
+        col, char = next((i, c) for i, c in enumerate(text) if not c.isascii())
+        plain = _ascii_hint(char)
+        hint = f" (a look-alike of {plain!r}?)" if plain.isascii() and plain != "?" else ""
+        if char in "\u03c0\u03a0":
+            hint = " (write pi)"
+        raise ExpressionError(f"cannot read {text[:60]!r}: the character {char!r} "
+                              f"(U+{ord(char):04X}) at column {col + 1} is not ASCII{hint}; "
+                              "expressions are written in ASCII")
     try:
         tree = ast.parse(text.strip(), mode="eval")
     except SyntaxError as exc:
@@ -187,7 +286,21 @@ def _parse_tree(text):
     if sum(1 for _ in ast.walk(tree)) > MAX_NODES:
         raise ExpressionError(f"expression {text[:60]!r}... is too complex "
                               f"(more than {MAX_NODES} parts)")
+    depth = _depth(tree.body)
+    if depth > MAX_DEPTH:
+        raise ExpressionError(f"expression {text[:60]!r}... is nested {depth} deep "
+                              f"(at most {MAX_DEPTH}); split it into parameters")
     return tree.body
+
+
+def _depth(root):
+    """Nesting depth of a parse tree, without recursion."""
+    deepest, stack = 0, [(root, 1)]
+    while stack:
+        node, d = stack.pop()
+        deepest = max(deepest, d)
+        stack.extend((child, d + 1) for child in ast.iter_child_nodes(node))
+    return deepest
 
 
 def parse(text, names=None):
@@ -200,7 +313,7 @@ def parse(text, names=None):
     node = _parse_tree(text)
     builder = _Builder(text, names, comparison=False)
     try:
-        return builder.build(node)
+        return builder.build(node)[0]
     except RecursionError:
         raise ExpressionError(f"cannot read {text[:60]!r}: too deeply nested") from None
 
@@ -221,10 +334,10 @@ def parse_condition(text, names=None):
             if op not in COMPARISONS:
                 builder.fail(f"comparison not allowed; use one of {', '.join(COMPARISONS.values())}",
                              node)
-            g = builder.build(node.left) - builder.build(node.comparators[0])
+            g = builder.build(node.left)[0] - builder.build(node.comparators[0])[0]
             direction = {ast.GtE: 1, ast.Gt: 1, ast.LtE: -1, ast.Lt: -1}.get(op)
             return g, direction
-        return builder.build(node), None
+        return builder.build(node)[0], None
     except RecursionError:
         raise ExpressionError(f"cannot read {text[:60]!r}: too deeply nested") from None
 
@@ -242,23 +355,78 @@ def names_in(text):
 
 
 def to_float(expr, values=None):
-    """``float`` of a sympy expression after substituting ``values`` ``{name: number}``;
-    raises ``ExpressionError`` if it is not a finite real number."""
+    """``float`` of a sympy expression with ``values`` ``{name: number}`` for its symbols;
+    raises ``ExpressionError`` if it is not a finite real number.
+
+    Evaluated in floating point node by node (never ``evalf``, whose exact arithmetic on
+    a huge constant such as ``sin(exp(exp(exp(9))))`` has no time bound).
+    """
     if isinstance(expr, (int, float)) and not isinstance(expr, bool):
         v = float(expr)
-    else:
-        if values:
-            expr = expr.subs({s: values[s.name] for s in expr.free_symbols if s.name in values})
-        if expr.free_symbols:
-            names = ", ".join(sorted(s.name for s in expr.free_symbols))
-            raise ExpressionError(f"{expr} still depends on {names}")
+        if not math.isfinite(v):
+            raise ExpressionError(f"{expr} is not finite")
+        return v
+    missing = sorted(s.name for s in expr.free_symbols if s.name not in (values or {}))
+    if missing:
+        raise ExpressionError(f"{expr} still depends on {', '.join(missing)}")
+    v = _evaluate(expr, values or {})
+    if abs(v) > MAX_CONSTANT:
+        raise ExpressionError(f"{expr} is too large ({v:.6g}; the limit is {MAX_CONSTANT:g})")
+    return v
+
+
+_SYMPY_FLOAT = {"Abs": "abs", "Min": "min", "Max": "max"}
+
+
+def _evaluate(expr, values):
+    """The float value of ``expr`` (symbols from ``values``), iteratively over its tree."""
+    memo = {}
+    stack = [expr]
+    while stack:
+        e = stack[-1]
+        if e in memo:
+            stack.pop()
+            continue
+        pending = [a for a in e.args if a not in memo]
+        if pending and not (e.is_Number or e.is_NumberSymbol or e.is_Symbol):
+            stack.extend(pending)
+            continue
+        stack.pop()
+        memo[e] = _evaluate_node(e, [memo.get(a) for a in e.args], values)
+    return memo[expr]
+
+
+def _evaluate_node(e, args, values):
+    if e.is_Symbol:
+        v = float(values[e.name])
+    elif e.is_Integer:
+        if abs(e.p).bit_length() > 1024:
+            raise ExpressionError(f"an integer of {len(str(abs(e.p)))} digits is too large")
+        v = float(e.p)
+    elif e.is_Number or e.is_NumberSymbol:
         try:
-            c = complex(expr.evalf(30))
-        except (TypeError, ValueError):
-            raise ExpressionError(f"{expr} is not a number") from None
-        if abs(c.imag) > 1e-12 * max(1.0, abs(c.real)):
-            raise ExpressionError(f"{expr} is not a real number (it is {c:.6g})")
-        v = c.real
+            v = float(e)
+        except (TypeError, OverflowError):
+            raise ExpressionError(f"{e} is not a finite real number") from None
+    elif e.is_Add:
+        v = math.fsum(args)
+    elif e.is_Mul:
+        v = math.prod(args)
+    elif e.is_Pow:
+        v, why = _float_power(*args)
+        if why:
+            raise ExpressionError(why)
+    else:
+        name = type(e).__name__
+        fname = _SYMPY_FLOAT.get(name, name)
+        if fname == "exp" or fname in FLOAT_FUNCTIONS:
+            v, why = _float_call(fname, args)
+            if why:
+                raise ExpressionError(why)
+        elif e == sympy.I or e.is_imaginary:
+            raise ExpressionError(f"{e} is not a real number")
+        else:
+            raise ExpressionError(f"{e} cannot be evaluated to a number")
     if not math.isfinite(v):
-        raise ExpressionError(f"{expr} is not finite")
+        raise ExpressionError(f"{e} is not finite")
     return v

@@ -26,6 +26,7 @@ import numpy as np
 
 from .elements import _vector3, has_symbols, numeric, parse_axis
 from .errors import ModelError
+from .names import identifier_problem
 
 KINDS = ("spring-damper", "joint-spring-damper", "bushing", "bearing", "contact")
 INTERPOLATIONS = ("pchip", "linear")
@@ -267,9 +268,10 @@ def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):
     ``System.add_force``)."""
     element = f"force {name!r}"
     parameters = parameters or {}
-    if not isinstance(name, str) or not name.isidentifier():
-        raise ModelError(f"force {name!r}: the name must be an identifier (letters, digits, "
-                         "underscore); it names the element's effect")
+    problem = identifier_problem(name)
+    if problem:
+        raise ModelError(f"force {name!r}: the name {problem}; it names the element's "
+                         "effect")
     if name in GLOBAL_EFFECTS:
         raise ModelError(f"{element}: the name is reserved for the {name} effect; choose "
                          "another")

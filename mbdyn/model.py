@@ -17,6 +17,7 @@ from .effects import parse_effects, warn_if_unphysical
 from .elements import (has_symbols, inertia_tensor, make_body, make_joint, make_load,
                        numeric)
 from .errors import ModelError, ModelWarning, SingularMassMatrixError
+from .names import identifier_problem, label_problem
 from .forces import GLOBAL_EFFECTS, make_force
 
 GROUND = "ground"
@@ -36,9 +37,9 @@ class System:
         self.name = str(name)
         self.parameters = {}
         for pname, value in (parameters or {}).items():
-            if not isinstance(pname, str) or not pname.isidentifier():
-                raise ModelError(f"system {name!r}: parameter name {pname!r} must be an "
-                                 "identifier")
+            problem = identifier_problem(pname)
+            if problem:
+                raise ModelError(f"system {name!r}: parameter name {pname!r} {problem}")
             try:
                 self.parameters[pname] = float(value)
             except (TypeError, ValueError):
@@ -69,8 +70,9 @@ class System:
         return syms[0] if len(syms) == 1 else syms
 
     def _check_new_frame(self, name):
-        if not isinstance(name, str) or not name:
-            raise ModelError(f"frame name must be a non-empty string, got {name!r}")
+        problem = label_problem(name)
+        if problem:
+            raise ModelError(f"frame name {name!r} {problem}")
         if name in self.graph:
             what = "the ground frame" if name == GROUND else "a frame"
             raise ModelError(f"body/frame {name!r}: the name is already used by {what}; "
@@ -122,8 +124,9 @@ class System:
         ``mb.t`` or three callables ``(q, q', q'')``).
         """
         element = f"joint {name!r}"
-        if not isinstance(name, str) or not name:
-            raise ModelError(f"joint name must be a non-empty string, got {name!r}")
+        problem = label_problem(name)
+        if problem:
+            raise ModelError(f"joint name {name!r} {problem}")
         if name in self._joints:
             raise ModelError(f"{element}: the name is already used by another joint")
         for role, frame in (("parent", parent), ("child", child)):

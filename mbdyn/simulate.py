@@ -18,8 +18,9 @@ from scipy import integrate, optimize
 from .balance import energy_balance
 from .events import Event, EventRecord, as_event, check_conditions
 from .force_packing import warn_outside_tables
-from .errors import (ModelError, NonFiniteError, SimulationError, SingularityWarning,
-                     SingularMassMatrixError)
+from . import limits
+from .errors import (ModelError, ModelWarning, NonFiniteError, SimulationError,
+                     SingularityWarning, SingularMassMatrixError)
 
 ADAPTIVE = {"RK45": integrate.RK45, "RK23": integrate.RK23, "DOP853": integrate.DOP853,
             "Radau": integrate.Radau, "BDF": integrate.BDF, "LSODA": integrate.LSODA}
@@ -295,7 +296,8 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
              rtol=DEFAULTS["rtol"], atol=DEFAULTS["atol"], dt=None, method=DEFAULTS["method"], events=(), t_eval=None, max_step=np.inf,
              outputs=(), points=None, progress=None, singularity_threshold=1e-3,
              reactions_frame="world",
-             compiled_loop=True):
+             compiled_loop=True, decimate=1, max_steps=None, max_samples=None,
+             max_wall_time=None):
     """Integrate ``model`` (a compiled ``Model``, or a ``System`` to compile) from ``t0``
     to ``t_end``.
 
@@ -314,6 +316,13 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     Euler-angle joint comes this close to its singularity (see ``Model.euler_singularity``).
     ``compiled_loop``: run fixed-step schemes in compiled stretches when the model allows
     (``method="jourdain"`` and no Python-function loads); ``False`` forces the Python loop.
+    ``decimate``: fixed-step schemes store every ``decimate``-th step (and the last).
+
+    Budgets (``mbdyn.limits``; ``docs/reliability.md``): ``max_steps`` integrator steps
+    (default ``MAX_STEPS``), ``max_samples`` stored samples (default ``MAX_SAMPLES``;
+    a fixed-step run that would exceed it is refused before it starts, with the estimate),
+    ``max_wall_time`` seconds (default none).  A run that reaches a budget stops with a
+    ``SimulationError`` that says which one and keeps the motion so far.
 
     Statistics include the mass matrix's condition number at the start and the end (a
     ``SingularityWarning`` when it is large), the largest quaternion drift and, with
@@ -339,6 +348,7 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
             raise ModelError(f"{name} must be a positive number, got {value!r}")
     if not max_step > 0:
         raise ModelError(f"max_step must be positive, got {max_step!r}")
+    budget = _budget(max_steps, max_samples, max_wall_time, decimate)
     if t_eval is not None:
         t_eval = np.asarray(t_eval, dtype=float).reshape(-1)
         if not np.all(np.isfinite(t_eval)):
@@ -367,16 +377,26 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
         raise ModelError("the initial state is unusable: " + failure)
     pre_stats = {}
     _conditioning(model, q, t0, pre_stats, "mass_matrix_condition_initial")
-    if integrator not in ADAPTIVE and (dt is None or not dt > 0):
-        raise ModelError(f"integrator {integrator!r} is fixed-step: give dt > 0")
+    if integrator not in ADAPTIVE:
+        dt = _check_fixed_step(integrator, dt, t0, t_end, t_eval, budget)
+    elif dt is not None:
+        warnings.warn(f"dt = {dt!r} is ignored: the adaptive integrator {integrator} chooses "
+                      "its own steps (bound them with max_step, or choose a fixed-step "
+                      f"integrator: {', '.join(FIXED_STEP)})", ModelWarning, stacklevel=2)
+    if t_eval is not None and len(t_eval) > budget["max_samples"]:
+        raise ModelError(f"t_eval asks for {len(t_eval)} samples, more than max_samples = "
+                         f"{budget['max_samples']}; ask for fewer or raise max_samples")
     start = _time.perf_counter()
+    budget["deadline"] = (None if budget["max_wall_time"] is None
+                          else start + budget["max_wall_time"])
     if integrator in ADAPTIVE:
         ts, ys, found, info = _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol,
-                                            max_step, events, t_eval, progress, monitor)
+                                            max_step, events, t_eval, progress, monitor,
+                                            budget)
     else:
         compiled = compiled_loop and method == "jourdain" and not model.has_callable_loads
         ts, ys, found, info = _run_fixed(rhs, integrator, t0, t_end, y0, float(dt), events,
-                                         t_eval, progress, monitor, compiled)
+                                         t_eval, progress, monitor, compiled, budget)
     wall = _time.perf_counter() - start
     ys = np.asarray(ys).reshape(len(ts), -1)
     stats = {"integrator": integrator, "method": method, "rtol": rtol, "atol": atol, "dt": dt,
@@ -405,6 +425,69 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     return result
 
 
+def _budget(max_steps, max_samples, max_wall_time, decimate):
+    """The run's budgets, checked: ``{max_steps, max_samples, max_wall_time, decimate}``."""
+    out = {"max_steps": limits.MAX_STEPS if max_steps is None else max_steps,
+           "max_samples": limits.MAX_SAMPLES if max_samples is None else max_samples,
+           "max_wall_time": limits.MAX_WALL_TIME if max_wall_time is None else max_wall_time,
+           "decimate": decimate}
+    for key in ("max_steps", "max_samples", "decimate"):
+        v = out[key]
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
+            raise ModelError(f"{key} must be a positive whole number, got {v!r}")
+    w = out["max_wall_time"]
+    if w is not None and (isinstance(w, bool) or not isinstance(w, (int, float))
+                          or not w > 0 or not np.isfinite(w)):
+        raise ModelError(f"max_wall_time must be a positive number of seconds, got {w!r}")
+    return out
+
+
+def _check_fixed_step(integrator, dt, t0, t_end, t_eval, budget):
+    """``dt`` as a float, after refusing what a fixed-step run cannot do: no or a bad
+    ``dt``, more steps than ``max_steps``, more stored samples than ``max_samples`` (both
+    known before the run starts)."""
+    if dt is None or isinstance(dt, bool):
+        raise ModelError(f"integrator {integrator!r} is fixed-step: give dt > 0")
+    try:
+        dt = float(dt)
+    except (TypeError, ValueError):
+        raise ModelError(f"dt must be a number, got {dt!r}") from None
+    if not (np.isfinite(dt) and dt > 0):
+        raise ModelError(f"integrator {integrator!r} is fixed-step: give dt > 0, got {dt!r}")
+    steps = (t_end - t0) / dt
+    if steps > budget["max_steps"]:
+        raise ModelError(f"(t_end - t0) / dt = {steps:.3g} steps, more than max_steps = "
+                         f"{budget['max_steps']}; take a larger dt, a shorter t_end, or "
+                         "raise max_steps (--max-steps)")
+    stored = len(t_eval) if t_eval is not None else steps / budget["decimate"] + 1
+    if stored > budget["max_samples"]:
+        raise ModelError(f"the run would store {stored:.3g} samples (about "
+                         f"{stored * 8 * 12 / 1e9:.2g} GB for a small model), more than "
+                         f"max_samples = {budget['max_samples']}; keep fewer (output_dt in a "
+                         "model file, decimate or t_eval in Python) or raise max_samples "
+                         "(--max-samples)")
+    return dt
+
+
+def _over_budget(budget, steps, stored, t, t_end, h=None):
+    """The message of a budget the run has used up, or ``None``."""
+    if steps >= budget["max_steps"]:
+        stiff = ""
+        if h is not None:
+            stiff = (f"; the last step was {h:.3g} s -- a stiff model under an explicit "
+                     "integrator takes tiny steps: try Radau or BDF")
+        return (f"stopped after max_steps = {budget['max_steps']} steps at t={t:.6g} of "
+                f"{t_end:.6g}{stiff}; or raise max_steps (--max-steps)")
+    if stored > budget["max_samples"]:
+        return (f"stopped at t={t:.6g}: the run has stored max_samples = "
+                f"{budget['max_samples']} samples; keep fewer (output_dt, t_eval) or raise "
+                "max_samples (--max-samples)")
+    if budget["deadline"] is not None and _time.perf_counter() > budget["deadline"]:
+        return (f"stopped at t={t:.6g} of {t_end:.6g}: the run took longer than "
+                f"max_wall_time = {budget['max_wall_time']:g} s; raise it (--max-wall-time)")
+    return None
+
+
 def _describe_failure(model, exc, t, y):
     names = model.coordinates + model.speeds
     state = ", ".join(f"{n}={v:.6g}" for n, v in zip(names, y))
@@ -425,7 +508,7 @@ def _crossed(e, g_old, g_new):
 
 
 def _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events, t_eval,
-                  progress, monitor):
+                  progress, monitor, budget):
     model = rhs.model
     solver_cls = ADAPTIVE[integrator]
     failure = None
@@ -509,6 +592,10 @@ def _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events, 
             progress(ts[-1] if ts else t_new)
         if stop_at is not None:
             break
+        if solver.status == "running":
+            failure = _over_budget(budget, steps, len(ts), t_new, t_end, h=t_new - t_prev)
+            if failure:
+                break
     info = {"steps": steps, "njev": getattr(solver, "njev", 0), "nlu": getattr(solver, "nlu", 0),
             "solver_rhs_evaluations": solver.nfev}
     if failure is not None:
@@ -588,11 +675,74 @@ _LOOP_STATUS = {
 }
 
 
+class _Samples:
+    """The samples a fixed-step run keeps, gathered stretch by stretch (arrays, not rows):
+    every ``every``-th step and the last one, or the states interpolated at ``t_eval``
+    (linearly between the steps that bracket each time)."""
+
+    def __init__(self, t0, y0, every=1, t_eval=None):
+        self.every = every
+        self.t_eval = None if t_eval is None else np.asarray(t_eval, dtype=float)
+        self.next_eval = 0
+        self.times, self.states = [], []
+        self.count = 0                  # samples kept
+        self.step = 0                   # steps seen
+        self.last = (t0, y0)            # the newest state, kept or not
+        self.last_kept = False
+        self._add([t0], y0[None, :], first=True)
+
+    def _add(self, ts, ys, first=False):
+        ts = np.asarray(ts, dtype=float)
+        if self.t_eval is not None:
+            t_prev, y_prev = self.last
+            lo = self.t_eval[self.next_eval:]
+            sel = lo[lo <= ts[-1]] if len(ts) else lo[:0]
+            if first:
+                sel = lo[lo <= ts[0]]
+            if sel.size:
+                tt = np.concatenate([[t_prev], ts]) if not first else ts
+                yy = np.vstack([y_prev[None, :], ys]) if not first else ys
+                self.times.append(sel)
+                self.states.append(np.column_stack([np.interp(sel, tt, yy[:, c])
+                                                    for c in range(yy.shape[1])]))
+                self.next_eval += sel.size
+                self.count += sel.size
+        else:
+            if first:
+                keep = np.array([0])
+            else:
+                index = self.step + 1 + np.arange(len(ts))
+                keep = np.flatnonzero(index % self.every == 0)
+            if keep.size:
+                self.times.append(ts[keep])
+                self.states.append(np.asarray(ys)[keep])
+                self.count += keep.size
+            self.last_kept = bool(len(ts)) and (first or keep.size and keep[-1] == len(ts) - 1)
+        if len(ts):
+            if not first:
+                self.step += len(ts)
+            self.last = (ts[-1], np.array(ys[-1], dtype=float))
+
+    def add(self, ts, ys):
+        if len(ts):
+            self._add(ts, ys)
+
+    def arrays(self):
+        """``(t, y)`` of the kept samples; the last state is always among them (without
+        ``t_eval``)."""
+        if self.t_eval is None and not self.last_kept:
+            self.times.append(np.array([self.last[0]]))
+            self.states.append(self.last[1][None, :])
+            self.last_kept = True
+        if not self.times:
+            return np.empty(0), np.empty((0, self.last[1].size))
+        return np.concatenate(self.times), np.vstack(self.states)
+
+
 def _run_fixed(rhs, integrator, t0, t_end, y0, dt, events, t_eval, progress, monitor,
-               compiled):
+               compiled, budget):
     model = rhs.model
-    ts = [t0]
-    ys = [y0.copy()]
+    kept = _Samples(t0, y0, budget["decimate"], t_eval)
     t, y = t0, y0
     g_old = _event_values(events, model, t, y) if events else None
     found = []
@@ -603,8 +753,7 @@ def _run_fixed(rhs, integrator, t0, t_end, y0, dt, events, t_eval, progress, mon
                                                       compiled, events):
         if not events:                      # no per-step work: take the stretch whole
             n_ok, failure = monitor.check_rows(times, states)
-            ts.extend(times[:n_ok])
-            ys.extend(states[:n_ok])
+            kept.add(times[:n_ok], states[:n_ok])
             steps += n_ok
             if n_ok:
                 t, y = times[n_ok - 1], states[n_ok - 1]
@@ -632,8 +781,7 @@ def _run_fixed(rhs, integrator, t0, t_end, y0, dt, events, t_eval, progress, mon
                         break
                 g_old = g_new
             t, y = t_new, y_new
-            ts.append(t)
-            ys.append(y)
+            kept.add(np.array([t]), y[None, :])
             if stop:
                 break
         if progress is not None:
@@ -641,13 +789,16 @@ def _run_fixed(rhs, integrator, t0, t_end, y0, dt, events, t_eval, progress, mon
         failure = failure or (None if stop else chunk_failure)  # past a terminal event: moot
         if failure or stop:
             break
-    ts, ys = np.array(ts), np.array(ys)
-    if t_eval is not None:
-        t_eval = np.asarray(t_eval, dtype=float)
-        t_eval = t_eval[t_eval <= ts[-1]]
-        ys = np.array([np.interp(t_eval, ts, ys[:, c]) for c in range(ys.shape[1])]).T
-        ts = t_eval
+        if t < t_end:
+            failure = _over_budget(budget, steps, kept.count, t, t_end)
+            if failure:
+                break
+    ts, ys = kept.arrays()
+    if not len(ts):                     # t_eval entirely beyond a failure or an event
+        ts, ys = np.array([t]), y[None, :]
     info = {"steps": steps, "compiled_loop": bool(compiled)}
+    if budget["decimate"] > 1:
+        info["samples_kept_every"] = budget["decimate"]
     if failure is not None:
         info["failure"] = failure
     return ts, ys, found, info

@@ -3,8 +3,9 @@ from __future__ import annotations
 
 import json
 import sys
+import warnings
 
-from ..errors import SimulationError
+from ..errors import ModelWarning, SimulationError
 from ..io.loader import METHODS
 from ..io.results import summary, write_results
 from ..simulate import FIXED_STEP, INTEGRATORS
@@ -41,6 +42,10 @@ def register(subparsers):
 
 def run(args):
     scene = load(args, FLAGS)
+    if args.dt is not None and scene.settings["integrator"] not in FIXED_STEP:
+        warnings.warn(f"--dt is ignored: the adaptive integrator "
+                      f"{scene.settings['integrator']} chooses its own steps (choose a "
+                      f"fixed-step --integrator: {', '.join(FIXED_STEP)})", ModelWarning)
     if args.plot:
         from ..viz.plots import _check_path
         _check_path(args.plot)

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from ..errors import ModelError
+from ..names import shown
 
 
 class ModelFileError(ModelError):
@@ -12,8 +13,8 @@ class ModelFileError(ModelError):
     """
 
     def __init__(self, file, key, problem):
-        self.file = str(file)
-        self.key = key or ""
-        self.problem = " ".join(str(problem).split())     # one line, always
+        self.file = shown(file)
+        self.key = shown(key or "")
+        self.problem = shown(" ".join(str(problem).split()))     # one line, always
         where = f"{self.file}: {self.key}: " if self.key else f"{self.file}: "
         super().__init__(where + self.problem)

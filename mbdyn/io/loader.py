@@ -15,6 +15,7 @@ import copy
 import math
 import os
 import re
+import stat
 import tomllib
 import warnings
 
@@ -22,6 +23,7 @@ import numpy as np
 import sympy
 
 from .. import compile as _compile
+from .. import limits
 from ..elements import t as TIME
 from ..errors import ModelError
 from ..model import GROUND, System
@@ -32,7 +34,7 @@ from ..events import CompiledCondition as _Condition
 from .errors import ModelFileError
 from .expressions import ExpressionError, parse, parse_condition, symbol, to_float
 from .schema import (DIRECTIONS, Checker, _suggest, apply_case, apply_override,
-                     parse_set_value, split_path)
+                     parse_set_value, scan_document, split_path)
 
 #: The formulations a run can use -- the one list behind ``[simulation] method`` and
 #: ``mbdyn run --method``.  Extend it here when a formulation is added.
@@ -41,24 +43,60 @@ METHODS = tuple(_compile.METHODS) + ("symbolic",)
 #: ``[simulation]`` defaults.
 DEFAULT_SIMULATION = dict(SIMULATE_DEFAULTS)     # one set of defaults (mbdyn.simulate)
 SIMULATE_KEYWORDS = ("t_end", "integrator", "method", "rtol", "atol", "dt", "max_step",
-                     "output_dt", "progress", "events", "outputs", "points")
+                     "output_dt", "progress", "events", "outputs", "points", "max_steps",
+                     "max_samples", "max_wall_time")
+BUDGETS = ("max_steps", "max_samples", "max_wall_time")
 
 
 def read_document(path):
-    """The parsed TOML of ``path``; errors name the file (and the line of a syntax error)."""
+    """The parsed TOML of ``path``; errors name the file (and the line of a syntax error).
+
+    Only regular files of at most ``limits.MAX_FILE_BYTES`` are read (a FIFO or a device
+    such as ``/dev/zero`` would block or never end); the parsed document is then checked
+    against the nesting and number limits (``scan_document``).
+    """
     file = str(path)
     try:
-        with open(path, "rb") as fh:
-            return tomllib.load(fh)
+        # non-blocking open: a FIFO without a writer must not hang the reader
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+        with os.fdopen(fd, "rb") as fh:
+            info = os.fstat(fd)
+            if not stat.S_ISREG(info.st_mode):
+                raise ModelFileError(file, "", "is not a regular file (a FIFO, device or "
+                                     "socket); give a .toml model file")
+            if info.st_size > limits.MAX_FILE_BYTES:
+                raise ModelFileError(file, "", f"is {info.st_size} bytes, more than a model "
+                                     f"file may be ({limits.MAX_FILE_BYTES}); is it really a "
+                                     "model file?")
+            if hasattr(os, "set_blocking"):
+                os.set_blocking(fd, True)
+            data = fh.read(limits.MAX_FILE_BYTES + 1)
     except FileNotFoundError:
         raise ModelFileError(file, "", "no such file; check the path") from None
     except IsADirectoryError:
         raise ModelFileError(file, "", "is a directory; give a .toml model file") from None
     except PermissionError:
         raise ModelFileError(file, "", "cannot be read (permission denied)") from None
+    except OSError as exc:
+        raise ModelFileError(file, "", f"cannot be read ({exc.strerror or exc})") from None
+    if len(data) > limits.MAX_FILE_BYTES:
+        raise ModelFileError(file, "", f"grew beyond {limits.MAX_FILE_BYTES} bytes while "
+                             "being read; give a finished model file")
+    return parse_document(data, file)
+
+
+def parse_document(data, file="<text>"):
+    """The parsed TOML of ``data`` (bytes or text); errors name ``file``."""
+    try:
+        text = data.decode("utf-8") if isinstance(data, bytes) else data
     except UnicodeDecodeError as exc:
         raise ModelFileError(file, "", f"is not UTF-8 text ({exc.reason} at byte "
                              f"{exc.start}); save it as UTF-8") from None
+    if "\x00" in text:
+        raise ModelFileError(file, f"line {text.count(chr(10), 0, text.index(chr(0))) + 1}",
+                             "holds a NUL character; is it a binary file?")
+    try:
+        doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         msg = str(exc)
         m = re.search(r"\(at line (\d+), column (\d+)\)", msg)
@@ -68,6 +106,15 @@ def read_document(path):
                                  f"(column {m.group(2)}); see docs/model-files.md") from None
         msg = re.sub(r"\s*\(at end of document\)", "", msg)
         raise ModelFileError(file, "end of file", f"TOML syntax error: {msg}") from None
+    except RecursionError:
+        raise ModelFileError(file, "", f"arrays or tables are nested too deeply (at most "
+                             f"{limits.MAX_NESTING} levels)") from None
+    except ValueError:                # an integer literal of thousands of digits
+        raise ModelFileError(file, "", f"holds an integer literal of more than 4300 digits "
+                             f"(at most {limits.MAX_INTEGER_DIGITS}); write it as a float "
+                             "such as 1.5e30") from None
+    scan_document(doc, file)
+    return doc
 
 
 def _normalise_overrides(overrides):
@@ -186,7 +233,8 @@ class Scene:
                             f"known: {', '.join(SIMULATE_KEYWORDS)}")
         s = dict(self.settings)
         s.update({k: v for k, v in overrides.items()
-                  if k in self.settings or k in ("t_end", "dt", "max_step", "output_dt")})
+                  if k in self.settings or k in ("t_end", "dt", "max_step", "output_dt")
+                  or k in BUDGETS})
         if s.get("t_end") is None:
             raise ModelFileError(self.path, "simulation.t_end", "is not set; add t_end = ... "
                                  "to [simulation] or pass --t-end (t_end=...)")
@@ -200,37 +248,36 @@ class Scene:
         points = overrides.get("points", self.outputs["points"])
         fixed = s["integrator"] in FIXED_STEP
         t_eval = None
+        budgets = {k: s[k] for k in BUDGETS if s.get(k) is not None}
+        max_samples = budgets.get("max_samples", limits.MAX_SAMPLES)
         if s.get("output_dt") and not fixed:
+            if s["t_end"] / s["output_dt"] + 1 > max_samples:
+                raise ModelFileError(self.path, "simulation.output_dt", f"t_end / output_dt = "
+                                     f"{s['t_end'] / s['output_dt']:.3g} samples, more than "
+                                     f"max_samples = {max_samples}; give a larger output_dt "
+                                     "or raise max_samples (--max-samples)")
             n = int(math.floor(s["t_end"] / s["output_dt"] + 1e-9))
             t_eval = np.linspace(0.0, n * s["output_dt"], n + 1)
             if t_eval[-1] < s["t_end"] - 1e-12:
                 t_eval = np.append(t_eval, s["t_end"])
         kwargs = dict(integrator=s["integrator"], rtol=s["rtol"], atol=s["atol"],
-                      dt=s.get("dt"), method=s["method"],
+                      dt=s.get("dt") if fixed else None, method=s["method"],
                       events=overrides.get("events", self.events), t_eval=t_eval,
-                      progress=overrides.get("progress"))
+                      progress=overrides.get("progress"), **budgets)
         if s.get("max_step"):
             kwargs["max_step"] = s["max_step"]
-        result = _simulate(self.model, s["t_end"], self.q0.copy(), self.u0.copy(), **kwargs)
-        if fixed and s.get("output_dt"):
-            result = _thin(result, max(1, int(round(s["output_dt"] / s["dt"]))))
+        if fixed and s.get("output_dt"):     # the integrator's own states, every k-th step
+            kwargs["decimate"] = max(1, int(round(s["output_dt"] / s["dt"])))
+        try:
+            result = _simulate(self.model, s["t_end"], self.q0.copy(), self.u0.copy(),
+                               **kwargs)
+        except ModelError as exc:
+            if isinstance(exc, ModelFileError):
+                raise
+            raise ModelFileError(self.path, "simulation", str(exc)) from None
         if outputs or points:
             result.compute_outputs(tuple(outputs), points or None, method="newton-euler")
         return result
-
-
-def _thin(result, every):
-    """Every ``every``-th sample of a fixed-step result, and always the last one (the
-    states are the integrator's own, not interpolated)."""
-    n = len(result.t)
-    if every <= 1 or n <= 2:
-        return result
-    idx = list(range(0, n, every))
-    if idx[-1] != n - 1:
-        idx.append(n - 1)
-    thin = Result(result.model, result.t[idx], result.q[idx], result.u[idx], result.events,
-                  dict(result.stats, samples_kept_every=every))
-    return thin
 
 
 class _SceneBuilder:
@@ -280,6 +327,7 @@ class _SceneBuilder:
         except ExpressionError as exc:
             raise self.error(path, f"{value!r} does not give a finite real number: {exc}") \
                 from None
+        self.bounded(v, path)
         if positive and not v > 0:
             raise self.error(path, f"must be > 0, got {v:g}")
         if nonnegative and v < 0:
@@ -294,7 +342,14 @@ class _SceneBuilder:
         except ExpressionError as exc:
             raise self.error(path, f"{value!r} does not give a finite real number: {exc}") \
                 from None
+        self.bounded(v, path)
         return e if e.free_symbols else v
+
+    def bounded(self, v, path):
+        if abs(v) > limits.MAX_MAGNITUDE:
+            raise self.error(path, f"{v:g} is beyond the range mbdyn accepts (|x| <= "
+                             f"{limits.MAX_MAGNITUDE:g}; products of such numbers overflow); "
+                             "check the units")
 
     def pvector(self, value, path, default=(0.0, 0.0, 0.0)):
         if value is None:
@@ -369,6 +424,7 @@ class _SceneBuilder:
                     except ExpressionError as exc:
                         raise self.error(("parameters", n), f"{raw[n]!r} does not give a "
                                          f"finite real number: {exc}") from None
+                    self.bounded(values[n], ("parameters", n))
                     del pending[n]
                     progressed = True
             if not progressed:
@@ -462,6 +518,13 @@ class _SceneBuilder:
                                       orientation=orientation, sequence=j.get("sequence"),
                                       coordinates=coordinates, speeds=speeds, drive=drive)
             joint = self.system.joints[name]
+            if joint.drive is not None:
+                try:                  # defined where the run starts (the files' t0 is 0)
+                    for part in (joint.drive.position, joint.drive.velocity,
+                                 joint.drive.acceleration):
+                        part(0.0)
+                except ArithmeticError as exc:
+                    raise self.error(path + ("drive",), str(exc)) from None
             if joint.drive is None:
                 clash = [n for n in joint.coordinates + joint.speeds if n in self.P or n == "t"]
                 if clash:
@@ -635,9 +698,15 @@ class _SceneBuilder:
                                  f"{_suggest(sim['method'], METHODS)}use one of: "
                                  f"{', '.join(METHODS)}")
             s["method"] = sim["method"]
-        for key in ("rtol", "atol", "dt", "max_step", "output_dt"):
+        for key in ("rtol", "atol", "dt", "max_step", "output_dt", "max_wall_time"):
             if key in sim:
                 s[key] = self.number(sim[key], path + (key,), positive=True)
+        for key in ("max_steps", "max_samples"):
+            if key in sim:
+                v = self.number(sim[key], path + (key,), positive=True)
+                if v != int(v):
+                    raise self.error(path + (key,), f"must be a whole number, got {v:g}")
+                s[key] = int(v)
         if s["integrator"] in FIXED_STEP and not s.get("dt"):
             raise self.error(path + ("integrator",), f"{s['integrator']!r} is a fixed-step "
                              "integrator: add dt = ... to [simulation] (or pass --dt)")

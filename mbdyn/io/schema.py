@@ -11,10 +11,14 @@ from __future__ import annotations
 
 import copy
 import difflib
+import math
 import re
 import tomllib
+import unicodedata
 
 from .errors import ModelFileError
+from .. import limits
+from ..names import identifier_problem, is_identifier, label_problem, shown
 from .expressions import RESERVED, ExpressionError, parse, parse_condition
 
 # ---------------------------------------------------------------------------- the schema
@@ -36,7 +40,8 @@ LOAD_KEYS = {"name": "name", "body": "name", "force": "vector", "moment": "vecto
              "point": "vector", "frame": ("choice", ("world", "body"))}
 SIMULATION_KEYS = {"t_end": "expr", "integrator": "string", "method": "string",
                    "rtol": "expr", "atol": "expr", "dt": "expr", "max_step": "expr",
-                   "output_dt": "expr"}
+                   "output_dt": "expr", "max_steps": "expr", "max_samples": "expr",
+                   "max_wall_time": "expr"}
 OUTPUT_KEYS = {"reactions": "reactions", "reactions_frame": ("choice", ("world", "child")),
                "energy": "bool", "points": "points"}
 POINT_KEYS = {"frame": "name", "offset": "vector"}
@@ -122,9 +127,59 @@ def _show(value):
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, str):
-        return f'"{value}"'
+        text = shown(value)
+        return f'"{text}"' if len(text) < 60 else f'"{text[:56]}..."'
     text = repr(value)
     return text if len(text) < 60 else text[:57] + "..."
+
+
+def scan_document(doc, file):
+    """Check every value of a parsed model file against the input limits (``mbdyn.limits``):
+    nesting depth, integer size, finite and bounded numbers, no control characters in keys
+    or strings (tab and newline aside).  Iterative: a hostile nesting cannot exhaust the
+    stack.  Raises ``ModelFileError`` at the first offending key."""
+    stack = [((), doc)]
+    while stack:
+        path, value = stack.pop()
+        where = format_path(path) if path else ""
+        if len(path) > limits.MAX_NESTING:
+            raise ModelFileError(file, format_path(path[:limits.MAX_NESTING]),
+                                 f"arrays or tables are nested more than {limits.MAX_NESTING} "
+                                 "levels deep; no model key needs that")
+        if isinstance(value, dict):
+            for k, v in value.items():
+                problem = label_problem(k) if k != "" else "must not be empty"
+                if problem or len(k) > limits.MAX_NAME_LENGTH:
+                    raise ModelFileError(file, format_path(path + (shown(k)[:60],)),
+                                         f"the key {problem or 'is too long'}")
+                stack.append((path + (k,), v))
+        elif isinstance(value, list):
+            stack.extend((path + (i,), v) for i, v in enumerate(value))
+        elif isinstance(value, bool):
+            continue
+        elif isinstance(value, int):
+            if len(str(abs(value))) > limits.MAX_INTEGER_DIGITS:
+                raise ModelFileError(file, where, f"the integer has {len(str(abs(value)))} "
+                                     f"digits (at most {limits.MAX_INTEGER_DIGITS}); write it "
+                                     "as a float such as 1.5e30 if you mean it")
+            _check_magnitude(file, where, float(value))
+        elif isinstance(value, float):
+            if not math.isfinite(value):
+                raise ModelFileError(file, where, f"{value} is not a finite number")
+            _check_magnitude(file, where, value)
+        elif isinstance(value, str):
+            bad = [c for c in value if unicodedata.category(c) == "Cc" and c not in "\t\n\r"]
+            if bad:
+                raise ModelFileError(file, where, "the text holds control characters ("
+                                     + ", ".join(f"U+{ord(c):04X}" for c in bad[:3])
+                                     + "); remove them")
+
+
+def _check_magnitude(file, where, value):
+    if abs(value) > limits.MAX_MAGNITUDE:
+        raise ModelFileError(file, where, f"{value:g} is beyond the range mbdyn accepts "
+                             f"(|x| <= {limits.MAX_MAGNITUDE:g}; products of such numbers "
+                             "overflow); check the units")
 
 
 # ---------------------------------------------------------------------------- checking
@@ -189,10 +244,9 @@ class Checker:
                                  f"{_kind_of(value)}")
             for name, v in value.items():
                 if key == "parameters":
-                    if not str(name).isidentifier():
-                        raise self.error(path + (name,), "a parameter name must be an "
-                                         "identifier (letters, digits, underscore; not "
-                                         "starting with a digit)")
+                    problem = identifier_problem(str(name))
+                    if problem:
+                        raise self.error(path + (name,), f"a parameter name {problem}")
                     if name in RESERVED:
                         raise self.error(path + (name,), f"{name!r} is a reserved name (t, pi "
                                          "and the functions); choose another parameter name")
@@ -244,9 +298,10 @@ class Checker:
             if not isinstance(value, str):
                 raise fail(path, f"must be a string, got {_kind_of(value)} {_show(value)}")
         elif kind == "name":
-            if not isinstance(value, str) or not value.isidentifier():
-                raise fail(path, f"must be a name of letters, digits and underscores (not "
-                           f"starting with a digit), got {_show(value)}")
+            problem = identifier_problem(value)
+            if problem:
+                raise fail(path, f"must be a name of ASCII letters, digits and underscores "
+                           f"(not starting with a digit): {_show(value)} {problem}")
         elif kind == "bool":
             if not isinstance(value, bool):
                 raise fail(path, f"must be true or false, got {_kind_of(value)} {_show(value)}")
@@ -308,8 +363,7 @@ class Checker:
                            "[w, x, y, z] or a 3x3 rotation matrix")
         elif kind == "names":
             items = [value] if isinstance(value, str) else value
-            if not isinstance(items, list) or not all(isinstance(n, str) and n.isidentifier()
-                                                      for n in items):
+            if not isinstance(items, list) or not all(is_identifier(n) for n in items):
                 raise fail(path, "must be a name or an array of names (letters, digits, "
                            f"underscores), got {_show(value)}")
             for n in items:
@@ -370,8 +424,9 @@ class Checker:
                 raise fail(path, "must be a table of points: NAME = { frame = \"...\", offset "
                            "= [x, y, z] }")
             for name, point in value.items():
-                if not str(name).isidentifier():
-                    raise fail(path + (name,), "a point name must be an identifier")
+                problem = identifier_problem(str(name))
+                if problem:
+                    raise fail(path + (name,), f"a point name {problem}")
                 self.check_table(point, POINT_KEYS, path + (name,), required=("frame",))
         else:  # pragma: no cover - a schema bug
             raise AssertionError(kind)
@@ -481,10 +536,23 @@ def parse_set_value(text):
     text = text.strip()
     if not text:
         raise ValueError("the value is empty")
+    if "\x00" in text:
+        raise ValueError("the value holds a NUL character")
     try:
-        return tomllib.loads("v = " + text)["v"]
+        value = tomllib.loads("v = " + text)["v"]
     except tomllib.TOMLDecodeError:
         return text
+    except RecursionError:
+        raise ValueError(f"arrays are nested too deeply (at most {limits.MAX_NESTING})") \
+            from None
+    except ValueError:                # an integer literal of thousands of digits
+        raise ValueError(f"the integer has more than 4300 digits (at most "
+                         f"{limits.MAX_INTEGER_DIGITS})") from None
+    try:
+        scan_document({"v": value}, "--set")
+    except ModelFileError as exc:
+        raise ValueError(exc.problem) from None
+    return value
 
 
 def apply_override(doc, path_text, value, checker, origin):

@@ -1,0 +1,45 @@
+"""The resource policy: every bound mbdyn puts on what an input may cost.
+
+A model file, an expression or a run that would exceed one of these is refused (or
+stopped) with a message that names the limit, the value that hit it and how to raise it
+where it can be raised.  ``docs/reliability.md`` lists them with their reasons.
+
+Limits on *inputs* (file size, nesting, expression size) are fixed: a model that needs
+more is better written differently.  Limits on *work* (stored samples, integrator steps,
+wall-clock time) are defaults a user raises per run: ``simulate(max_samples=...,
+max_steps=..., max_wall_time=...)``, the same keys in ``[simulation]``, or
+``mbdyn run --max-samples/--max-steps/--max-wall-time``.
+"""
+from __future__ import annotations
+
+# -- inputs
+#: bytes of one model file (the largest model in models/ is ~4 kB)
+MAX_FILE_BYTES = 1_000_000
+#: nesting of arrays and tables in a model file (the deepest legitimate use is 3)
+MAX_NESTING = 16
+#: magnitude of any number written in a model file or given as a value (beyond it,
+#: products overflow double precision; no SI quantity of a mechanism comes near)
+MAX_MAGNITUDE = 1e100
+#: decimal digits of an integer literal (a float holds ~17)
+MAX_INTEGER_DIGITS = 40
+#: characters of one expression, its parse-tree nodes and the depth of its nesting
+MAX_EXPRESSION_LENGTH = 2000
+MAX_EXPRESSION_NODES = 1000
+MAX_EXPRESSION_DEPTH = 60
+#: |exponent| of a power
+MAX_EXPONENT = 1000
+#: magnitude of any constant part of an expression (beyond it, sympy's exact arithmetic
+#: on huge numbers costs time and memory without meaning)
+MAX_CONSTANT = 1e300
+#: terms an expression would have once expanded (the symbolic layer expands)
+MAX_EXPANDED_TERMS = 20_000
+#: characters of a name (element, coordinate, parameter, case)
+MAX_NAME_LENGTH = 100
+
+# -- work (defaults a user can raise)
+#: stored samples of one run (rows of t, q, u); beyond it give output_dt to decimate
+MAX_SAMPLES = 2_000_000
+#: integrator steps of one run
+MAX_STEPS = 20_000_000
+#: wall-clock seconds of one run (None: no limit)
+MAX_WALL_TIME = None
