@@ -391,6 +391,10 @@ class Model:
         drift = 0.0
         for s in self._quaternions:
             n = np.linalg.norm(q[s])
+            if not (np.isfinite(n) and n > 0):
+                raise NonFiniteError(f"model {self.name!r}: the quaternion "
+                                     f"{', '.join(self.coordinates[s])} is {q[s].tolist()}, "
+                                     "which has no direction; give a finite, non-zero one")
             drift = max(drift, abs(n - 1.0))
             q[s] /= n
         return drift
@@ -422,6 +426,16 @@ class Model:
         self._udfull[:] = 0.0
         self._fill_inputs(q, u, t)
         return q, u
+
+    def _require_finite(self, q, u, t=0.0):
+        """``NonFiniteError`` naming the coordinates and speeds that are NaN or Inf."""
+        bad = [n for n, x in zip(self.coordinates + self.speeds,
+                                 np.concatenate([np.ravel(q), np.ravel(u)]))
+               if not np.isfinite(x)]
+        if bad:
+            raise NonFiniteError(f"model {self.name!r}, t={t:.6g}: the state holds non-finite "
+                                 f"values in {', '.join(bad)}; give finite coordinates and "
+                                 "speeds")
 
     def _state(self, q, u):
         q = np.asarray(q, dtype=float)
@@ -577,6 +591,10 @@ class Model:
     def mass_matrix(self, q, t=0.0):
         """The Jourdain mass matrix ``M(q)`` (nu x nu, symmetric)."""
         self._jourdain_terms(q, np.zeros(self.nu), t)
+        if not np.all(np.isfinite(self._M)):
+            self._require_finite(q, np.zeros(self.nu), t)
+            raise NonFiniteError(f"model {self.name!r}, t={t:.6g}: the mass matrix came out "
+                                 "non-finite (check masses, inertias and drives)")
         return self._M.copy()
 
     def forcing(self, q, u, t=0.0):
@@ -640,6 +658,12 @@ class Model:
 
     def _raise_singular(self, q, t, pivot):
         M = self._M
+        if not np.all(np.isfinite(M)):   # a NaN pivot: the input, not the inertia
+            self._require_finite(q, self._ufull[self._free_u] if self._driven else
+                                 self._ufull, t)
+            self._check_finite(q, np.zeros(self.nu), t, M.reshape(-1), "the mass matrix",
+                               names=[f"M[{i},{j}]" for i in range(self.nu)
+                                      for j in range(self.nu)])
         eigval, eigvec = np.linalg.eigh(0.5 * (M + M.T))
         scale = max(abs(eigval).max(), 1e-300)
         null = eigvec[:, eigval <= 1e-12 * scale]

@@ -496,7 +496,15 @@ def _describe_failure(model, exc, t, y):
 
 def _event_values(events, model, t, y):
     nq = model.nq
-    return np.array([float(e.condition(t, y[:nq], y[nq:])) for e in events])
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        values = np.array([float(e.condition(t, y[:nq], y[nq:])) for e in events])
+    if not np.all(np.isfinite(values)):
+        bad = [e.name for e, v in zip(events, values) if not np.isfinite(v)]
+        raise NonFiniteError(f"event {', '.join(map(repr, bad))}: the condition is not a "
+                             f"finite number at t={t:.6g} (e.g. a square root or logarithm "
+                             "of a negative value, a division by zero), so its crossing "
+                             "cannot be found; write a condition defined over the whole motion")
+    return values
 
 
 def _crossed(e, g_old, g_new):
@@ -545,7 +553,11 @@ def _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events, 
             break
         stop_at = None
         if events:
-            g_new = _event_values(events, model, t_new, y_new)
+            try:
+                g_new = _event_values(events, model, t_new, y_new)
+            except NonFiniteError as exc:
+                failure = _describe_failure(model, exc, t_new, y_new)
+                break
             dense = None
             hits = []
             for k, e in enumerate(events):
@@ -764,7 +776,11 @@ def _run_fixed(rhs, integrator, t0, t_end, y0, dt, events, t_eval, progress, mon
                 break
             steps += 1
             if events:
-                g_new = _event_values(events, model, t_new, y_new)
+                try:
+                    g_new = _event_values(events, model, t_new, y_new)
+                except NonFiniteError as exc:
+                    failure = _describe_failure(model, exc, t_new, y_new)
+                    break
                 hits = []
                 for j, e in enumerate(events):
                     if _crossed(e, g_old[j], g_new[j]):

@@ -7,13 +7,17 @@ its name to ``COMMANDS``.
 
 Exit codes: 0 success; 1 a model file or input that cannot be used (one-line message on
 stderr); 2 a bad command line; 3 a simulation that failed (NaN, singularity, integrator
-failure); 130 interrupted.  No traceback unless ``MBDYN_DEBUG=1``.
+failure, a budget reached); 130 interrupted (SIGINT), 143 terminated (SIGTERM) -- either
+way no temporary or torn result file is left; 141 the reader of stdout went away (no
+message).  70 is an internal error: a bug, to be reported.  No traceback unless
+``MBDYN_DEBUG=1``.
 """
 from __future__ import annotations
 
 import argparse
 import importlib
 import os
+import signal
 import sys
 import warnings
 
@@ -21,6 +25,7 @@ COMMANDS = ["run", "info", "eom", "accuracy", "equilibrium", "modes", "campbell"
             "animate", "sweep"]
 
 EXIT_OK, EXIT_INPUT, EXIT_USAGE, EXIT_SIMULATION, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
+EXIT_TERMINATED, EXIT_BROKEN_PIPE = 143, 141
 
 
 class ArgumentParser(argparse.ArgumentParser):
@@ -44,7 +49,27 @@ def build_parser():
 
 
 def _one_line(text):
-    return " ".join(str(text).split())
+    """One line, control characters escaped (a name cannot drive the terminal)."""
+    from ..names import shown
+    return shown(" ".join(str(text).split()))
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised in the main thread so that temporaries are removed on the way out."""
+
+
+def _on_sigterm(signum, frame):
+    raise Terminated()
+
+
+def _quiet_stdout():
+    """After the reader of stdout went away: send the rest to /dev/null (no "Broken
+    pipe" message at exit)."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):
+        pass
 
 
 def _error(message):
@@ -64,6 +89,23 @@ def main(argv=None):
         return EXIT_USAGE
     from ..errors import ModelError, SimulationError
     debug = bool(os.environ.get("MBDYN_DEBUG"))
+    try:
+        previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    except ValueError:                # not the main thread (e.g. called from a test)
+        previous = None
+    try:
+        code = _dispatch(args, debug, ModelError, SimulationError)
+        sys.stdout.flush()              # a closed pipe shows here, not at exit
+        return code
+    except BrokenPipeError:
+        _quiet_stdout()
+        return EXIT_BROKEN_PIPE
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _dispatch(args, debug, ModelError, SimulationError):
     with warnings.catch_warnings():
         warnings.simplefilter("always")
         seen = set()
@@ -76,9 +118,25 @@ def main(argv=None):
         warnings.showwarning = show
         try:
             return args.func(args) or EXIT_OK
+        except Terminated:
+            sys.stderr.write("\nmbdyn: terminated (SIGTERM); no partial files were left\n")
+            return EXIT_TERMINATED
         except KeyboardInterrupt:
-            sys.stderr.write("\nmbdyn: interrupted\n")
+            sys.stderr.write("\nmbdyn: interrupted; no partial files were left\n")
             return EXIT_INTERRUPTED
+        except BrokenPipeError:
+            raise
+        except RecursionError as exc:
+            if debug:
+                raise
+            _error(f"the input is nested too deeply to process ({exc}); simplify it")
+            return EXIT_INPUT
+        except MemoryError:
+            if debug:
+                raise
+            _error("out of memory; the run or its results are too large -- shorten t_end, "
+                   "give output_dt, or lower --max-samples")
+            return EXIT_SIMULATION
         except SimulationError as exc:
             if debug:
                 raise

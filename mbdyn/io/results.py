@@ -7,10 +7,12 @@ half-written file behind (either the old file or the complete new one is there).
 from __future__ import annotations
 
 import datetime
+import hashlib
 import io
 import json
 import math
 import os
+import re
 import tempfile
 
 import numpy as np
@@ -114,47 +116,113 @@ def columns(scene, result):
                              for c in cols])
 
 
-def atomic_write(path, text):
-    """Write ``text`` to ``path`` via a temporary file and ``os.replace``."""
+def _temporary(path):
+    """A new temporary file beside ``path``, named ``.NAME.PID.RANDOM.tmp`` (hidden, and
+    recognisable as this process's); returns ``(fd, tmp_path)``."""
     directory = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", suffix=".tmp",
-                               dir=directory)
+    fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(path)}.{os.getpid()}.",
+                               suffix=".tmp", dir=directory)
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)
+    return fd, tmp
+
+
+def _write_temporary(path, data):
+    """``data`` (text) in a flushed, synced temporary beside ``path``; returns its path."""
+    fd, tmp = _temporary(path)
     try:
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
         with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
-            fh.write(text)
+            fh.write(data)
             fh.flush()
             os.fsync(fh.fileno())
+    except BaseException:
+        _unlink(tmp)
+        raise
+    return tmp
+
+
+def _unlink(path):
+    try:
+        os.unlink(path)
+    except OSError:
+        pass
+
+
+def atomic_write(path, text):
+    """Write ``text`` to ``path`` via a temporary file and ``os.replace``: a reader sees
+    the old file or the whole new one, never a part; the temporary is removed on any
+    error or interruption (SIGINT, and SIGTERM under the ``mbdyn`` command)."""
+    tmp = _write_temporary(path, text)
+    try:
         os.replace(tmp, path)
     except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
+        _unlink(tmp)
         raise
 
 
+def remove_stale_temporaries(directory, names):
+    """Remove temporaries ``.NAME.PID.*.tmp`` of ``names`` left in ``directory`` by a
+    process that no longer runs (killed with SIGKILL mid-write)."""
+    try:
+        entries = os.listdir(directory)
+    except OSError:
+        return
+    for entry in entries:
+        for name in names:
+            prefix = f".{name}."
+            if not (entry.startswith(prefix) and entry.endswith(".tmp")):
+                continue
+            pid = entry[len(prefix):].split(".", 1)[0]
+            if pid.isdigit() and int(pid) != os.getpid() and not _running(int(pid)):
+                _unlink(os.path.join(directory, entry))
+
+
+def _running(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:
+        return True
+    return True
+
+
+_UNSAFE = re.compile(r"[^A-Za-z0-9_.+-]")
+
+
 def output_stem(scene):
-    """``top_a`` for model file ``top.toml`` and case ``a``."""
-    stem = os.path.splitext(os.path.basename(scene.path))[0]
-    return f"{stem}_{scene.case}" if scene.case else stem
+    """``top_a`` for model file ``top.toml`` and case ``a``; characters other than
+    letters, digits and ``_ . + -`` become ``_`` (a case named ``../x`` cannot write
+    outside the output directory)."""
+    stem = os.path.splitext(os.path.basename(str(scene.path)))[0]
+    stem = f"{stem}_{scene.case}" if scene.case else stem
+    stem = _UNSAFE.sub("_", stem).lstrip(".") or "results"
+    return stem[:120]
 
 
 def write_results(directory, scene, result, status="ok", error=None, extra=None):
     """Write ``STEM.csv`` (named columns) and ``STEM.json`` (metadata) into ``directory``
-    (created if needed); returns the two paths.  The JSON is written last, so its
-    presence means the CSV beside it is complete."""
+    (created if needed); returns the two paths.
+
+    The pair is written as one unit: both are first written whole to temporaries; then
+    the old JSON is removed, the CSV renamed into place and the JSON last.  So a JSON
+    beside a CSV always describes it (it also records the CSV's size, row count and
+    SHA-256), and an interruption at any point leaves either the old pair, a CSV with no
+    JSON, or the new pair -- never a JSON of another CSV, never a temporary (but after
+    SIGKILL, whose leftovers the next write removes).
+    """
     os.makedirs(directory, exist_ok=True)
     stem = output_stem(scene)
     csv_path = os.path.join(directory, stem + ".csv")
     json_path = os.path.join(directory, stem + ".json")
+    remove_stale_temporaries(directory, (stem + ".csv", stem + ".json"))
     names, table = columns(scene, result)
     buf = io.StringIO()
     buf.write(",".join(names) + "\n")
     np.savetxt(buf, table, delimiter=",", fmt="%.15g")
-    atomic_write(csv_path, buf.getvalue())
+    csv_text = buf.getvalue()
+    csv_bytes = csv_text.encode("utf-8")
     meta = summary(scene, result)
     meta.update({
         "status": status,
@@ -167,6 +235,8 @@ def write_results(directory, scene, result, status="ok", error=None, extra=None)
         "outputs": outputs_spec(scene),
         "warnings": list(scene.warnings),
         "csv": os.path.basename(csv_path),
+        "csv_bytes": len(csv_bytes),
+        "csv_sha256": hashlib.sha256(csv_bytes).hexdigest(),
         "columns": names,
         "samples": int(len(result.t)),
         "stats_all": {k: _jsonable(v) for k, v in result.stats.items()},
@@ -174,8 +244,34 @@ def write_results(directory, scene, result, status="ok", error=None, extra=None)
     })
     if extra:
         meta.update(extra)
-    atomic_write(json_path, json.dumps(meta, indent=2, default=_jsonable) + "\n")
+    json_text = json.dumps(meta, indent=2, default=_jsonable) + "\n"
+    temporaries = []
+    try:
+        temporaries.append(_write_temporary(csv_path, csv_text))
+        temporaries.append(_write_temporary(json_path, json_text))
+        _unlink(json_path)                 # no old JSON may stand beside the new CSV
+        os.replace(temporaries[0], csv_path)
+        os.replace(temporaries[1], json_path)
+    except BaseException:
+        for tmp in temporaries:
+            _unlink(tmp)
+        raise
     return csv_path, json_path
+
+
+def verify_results(json_path):
+    """``True`` if the CSV that ``json_path`` names is the one it describes (size and
+    SHA-256); a reader's check that the pair is whole."""
+    with open(json_path, encoding="utf-8") as fh:
+        meta = json.load(fh)
+    csv_path = os.path.join(os.path.dirname(os.path.abspath(json_path)), meta["csv"])
+    try:
+        with open(csv_path, "rb") as fh:
+            data = fh.read()
+    except OSError:
+        return False
+    return (len(data) == meta.get("csv_bytes")
+            and hashlib.sha256(data).hexdigest() == meta.get("csv_sha256"))
 
 
 def _jsonable(v):
