@@ -5,6 +5,7 @@ import json
 import sys
 import warnings
 
+from .. import limits
 from ..errors import ModelWarning, SimulationError
 from ..io.loader import METHODS
 from ..io.results import summary, write_results
@@ -14,7 +15,9 @@ from .common import Progress, add_model_arguments, fmt, load
 #: options that are shorthands of --set simulation.KEY=VALUE
 FLAGS = (("simulation.t_end", "--t-end"), ("simulation.method", "--method"),
          ("simulation.integrator", "--integrator"), ("simulation.rtol", "--rtol"),
-         ("simulation.atol", "--atol"), ("simulation.dt", "--dt"))
+         ("simulation.atol", "--atol"), ("simulation.dt", "--dt"),
+         ("simulation.max_steps", "--max-steps"), ("simulation.max_samples", "--max-samples"),
+         ("simulation.max_wall_time", "--max-wall-time"))
 
 
 def register(subparsers):
@@ -31,6 +34,12 @@ def register(subparsers):
     p.add_argument("--rtol", metavar="R", help="relative tolerance (adaptive integrators)")
     p.add_argument("--atol", metavar="A", help="absolute tolerance (adaptive integrators)")
     p.add_argument("--dt", metavar="H", help="step size (fixed-step integrators)")
+    p.add_argument("--max-steps", metavar="N", help="step budget of the run (default "
+                   f"{limits.MAX_STEPS}); see docs/reliability.md")
+    p.add_argument("--max-samples", metavar="N", help="stored samples at most (default "
+                   f"{limits.MAX_SAMPLES}); beyond, give output_dt")
+    p.add_argument("--max-wall-time", metavar="S", help="stop the run after S seconds of "
+                   "wall time (default: no limit)")
     p.add_argument("--out", metavar="DIR", help="write STEM.csv (named columns) and "
                                                 "STEM.json (metadata) into DIR")
     p.add_argument("--json", action="store_true",

@@ -364,8 +364,11 @@ class Checker:
         elif kind == "names":
             items = [value] if isinstance(value, str) else value
             if not isinstance(items, list) or not all(is_identifier(n) for n in items):
-                raise fail(path, "must be a name or an array of names (letters, digits, "
-                           f"underscores), got {_show(value)}")
+                bad = next((n for n in items if not is_identifier(n)), value) \
+                    if isinstance(items, list) else value
+                why = identifier_problem(bad) if isinstance(bad, str) else "is not a name"
+                raise fail(path, "must be a name or an array of names (ASCII letters, digits, "
+                           f"underscores): {_show(bad)} {why}")
             for n in items:
                 if n in RESERVED:
                     raise fail(path, f"{n!r} is a reserved name (t, pi and the functions); "
