@@ -162,6 +162,13 @@ FILE_CASES = [
     ("nul-in-text", BASE.replace('name = "bob"', 'name = "b\\u0000b"'), RUN, 1,
      r"control characters"),
     ("unknown-case", BASE, RUN + ["--case", "\x1b[31mred"], 1, r"no case '\\x1b\[31mred'"),
+    ("t-end-flag-huge", BASE, RUN + ["--t-end", "1e300"], 1, r"--t-end 1e300.*range"),
+    ("t-end-flag-nan", BASE, RUN + ["--t-end", "nan"], 1, r"--t-end nan.*not a finite"),
+    ("max-steps-fraction", BASE, RUN + ["--max-steps", "1.5"], 1, r"whole number"),
+    ("output-dt-below-dt", model_text() + 'integrator = "rk4"\ndt = 0.01\noutput_dt = 1e-3\n',
+     RUN, 0, r"output_dt.*smaller than dt"),
+    ("accuracy-t-end-nan", BASE, ["accuracy", "{model}", "--t-end", "nan"], 1,
+     r"--t-end nan"),
 ]
 
 

@@ -1,6 +1,8 @@
 """``mbdyn accuracy MODEL``: what accuracy costs in time -- a work-precision study."""
 from __future__ import annotations
 
+import math
+
 import json
 import sys
 
@@ -56,6 +58,10 @@ def run(args):
     t_end = args.t_end if args.t_end is not None else scene.settings.get("t_end")
     if not t_end:
         raise ModelError(f"{scene.path}: simulation.t_end is not set; pass --t-end T")
+    if not (math.isfinite(t_end) and t_end > 0):
+        raise ModelError(f"--t-end {t_end}: give a positive, finite end time")
+    if not (math.isfinite(args.budget) and args.budget > 0):
+        raise ModelError(f"--budget {args.budget}: give a positive number of seconds")
     integrators = DEFAULT_INTEGRATORS
     if args.integrators:
         integrators = tuple(x.strip() for x in args.integrators.split(",") if x.strip())

@@ -5,6 +5,7 @@ import sys
 import time
 import warnings
 
+from ..io.errors import ModelFileError
 from ..io.loader import load_model
 from ..io.schema import parse_set_value
 
@@ -33,7 +34,10 @@ def overrides(args, flags=()):
         value = getattr(args, flag.lstrip("-").replace("-", "_"), None)
         if value is None:
             continue
-        parsed = parse_set_value(value) if isinstance(value, str) else value
+        try:
+            parsed = parse_set_value(value) if isinstance(value, str) else value
+        except ValueError as exc:
+            raise ModelFileError(args.model, f"{flag} {value}", str(exc)) from None
         out.append((path, parsed, f"{flag} {value}"))
     return out
 

@@ -25,7 +25,7 @@ import sympy
 from .. import compile as _compile
 from .. import limits
 from ..elements import t as TIME
-from ..errors import ModelError
+from ..errors import ModelError, ModelWarning
 from ..model import GROUND, System
 from ..simulate import DEFAULTS as SIMULATE_DEFAULTS
 from ..simulate import FIXED_STEP, INTEGRATORS, Event, Result
@@ -710,6 +710,11 @@ class _SceneBuilder:
         if s["integrator"] in FIXED_STEP and not s.get("dt"):
             raise self.error(path + ("integrator",), f"{s['integrator']!r} is a fixed-step "
                              "integrator: add dt = ... to [simulation] (or pass --dt)")
+        if (s["integrator"] in FIXED_STEP and s.get("output_dt")
+                and s["output_dt"] < s["dt"] * (1 - 1e-9)):
+            warnings.warn(f"simulation.output_dt = {s['output_dt']:g} is smaller than dt = "
+                          f"{s['dt']:g}: a fixed-step run keeps its own steps, so every step "
+                          "is stored", ModelWarning)
         return s
 
     def outputs(self):
