@@ -39,7 +39,8 @@ MAX_NAME_LENGTH = 100
 # -- work (defaults a user can raise)
 #: stored samples of one run (rows of t, q, u); beyond it give output_dt to decimate
 MAX_SAMPLES = 2_000_000
-#: integrator steps of one run
-MAX_STEPS = 20_000_000
+#: integrator steps of one run (an adaptive run that, at its pace, could not finish
+#: within them stops early: see ``simulate.PROJECTION_STEPS``)
+MAX_STEPS = 5_000_000
 #: wall-clock seconds of one run (None: no limit)
 MAX_WALL_TIME = None

@@ -9,6 +9,7 @@ classic RK4; quaternions are projected back onto the unit sphere after every ste
 """
 from __future__ import annotations
 
+import collections
 import time as _time
 import warnings
 
@@ -488,6 +489,26 @@ def _over_budget(budget, steps, stored, t, t_end, h=None):
     return None
 
 
+#: every this many steps an adaptive run projects its step count from the median of its
+#: last this many step sizes (a median: a burst of tiny steps at an impact does not count)
+PROJECTION_STEPS = 1000
+
+
+def _projected_over_budget(budget, steps, t, t_end, recent):
+    """Stop early a run that cannot finish within ``max_steps`` at its current pace."""
+    h = float(np.median(recent))
+    if not h > 0:
+        return None
+    projected = steps + (t_end - t) / h
+    if projected <= budget["max_steps"]:
+        return None
+    return (f"stopped at t={t:.6g} of {t_end:.6g} after {steps} steps: at its current step "
+            f"size (median {h:.3g} s) the run would need about {projected:.2g} steps, more "
+            f"than max_steps = {budget['max_steps']} -- a stiff model under an explicit "
+            "integrator takes tiny steps: try Radau or BDF; or raise max_steps "
+            "(--max-steps)")
+
+
 def _describe_failure(model, exc, t, y):
     names = model.coordinates + model.speeds
     state = ", ".join(f"{n}={v:.6g}" for n, v in zip(names, y))
@@ -534,6 +555,7 @@ def _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events, 
     g_old = _event_values(events, model, t0, y0) if events else None
     found = []
     steps = 0
+    recent = collections.deque(maxlen=PROJECTION_STEPS)
     while solver.status == "running":
         t_prev, y_prev = solver.t, solver.y.copy()
         try:
@@ -605,7 +627,10 @@ def _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events, 
         if stop_at is not None:
             break
         if solver.status == "running":
+            recent.append(t_new - t_prev)
             failure = _over_budget(budget, steps, len(ts), t_new, t_end, h=t_new - t_prev)
+            if not failure and steps % PROJECTION_STEPS == 0:
+                failure = _projected_over_budget(budget, steps, t_new, t_end, recent)
             if failure:
                 break
     info = {"steps": steps, "njev": getattr(solver, "njev", 0), "nlu": getattr(solver, "nlu", 0),

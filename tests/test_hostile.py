@@ -298,6 +298,23 @@ def test_a_stiff_model_under_an_explicit_integrator_stops_at_the_step_budget():
     assert len(info.value.result.t) > 100 and info.value.result.t[-1] < 10.0
 
 
+def test_a_run_that_cannot_finish_at_its_pace_stops_early_with_the_projection():
+    s = mb.System("stiff", gravity=(0, 0, 0))
+    s.add_body("b", mass=1e-6, com=(0, 0, 0))
+    s.add_joint("x", "prismatic", "ground", "b", axis="x")
+    s.add_force("spring", "joint-spring-damper", joint="x", stiffness=1e9)
+    with pytest.raises(mb.SimulationError, match=r"would need about .* steps.*Radau") as info:
+        mb.simulate(s, 1e4, q0={"x": 0.01}, max_steps=100_000)
+    assert len(info.value.result.t) <= 2000      # stopped at the first projection
+
+
+def test_a_burst_of_tiny_steps_does_not_trip_the_projection():
+    model = mb.load_model(os.path.join(ROOT, "models", "bouncing_ball.toml"))
+    res = model.simulate(max_steps=200_000)       # impacts: bursts of tiny steps
+    assert res.stats["status"] == "ok"
+    assert res.t[-1] == pytest.approx(model.settings["t_end"])
+
+
 def test_decimated_fixed_step_runs_keep_the_integrators_own_states():
     s = _pendulum()
     full = mb.simulate(s, 1.0, q0={"hinge": 0.3}, integrator="rk4", dt=0.01)
