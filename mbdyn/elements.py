@@ -14,6 +14,7 @@ import numpy as np
 import sympy
 
 from .errors import ModelError, ModelWarning, NonFiniteError
+from .expressions import RESERVED
 from .names import identifier_problem
 from .kernels.joints import KIND_CODES, NQ, NU
 
@@ -389,6 +390,10 @@ def _default_names(name, kind, coordinates, speeds, element):
         problem = identifier_problem(n)
         if problem:
             raise ModelError(f"{element}: coordinate/speed name {n!r} {problem}")
+        if n in RESERVED:
+            raise ModelError(f"{element}: coordinate/speed name {n!r} is reserved (t, pi and "
+                             "the functions of expressions); name the joint otherwise or "
+                             "pass coordinates=[...]")
     return qn, un
 
 

@@ -36,6 +36,11 @@ MAX_EXPANDED_TERMS = 20_000
 #: characters of a name (element, coordinate, parameter, case)
 MAX_NAME_LENGTH = 100
 
+#: values of one range (START:STOP:N of a sweep axis or of a Campbell diagram)
+MAX_RANGE_POINTS = 100_000
+#: members of one sweep (the product of its axes, times its cases)
+MAX_SWEEP_MEMBERS = 1_000_000
+
 # -- work (defaults a user can raise)
 #: stored samples of one run (rows of t, q, u); beyond it give output_dt to decimate
 MAX_SAMPLES = 2_000_000

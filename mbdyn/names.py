@@ -9,6 +9,7 @@ are refused everywhere: printed raw they would drive the user's terminal.
 """
 from __future__ import annotations
 
+import keyword
 import unicodedata
 
 from .limits import MAX_NAME_LENGTH
@@ -46,6 +47,10 @@ def identifier_problem(name):
     if not name.isidentifier():
         return ("is not an identifier: use letters, digits and underscores, not starting "
                 "with a digit")
+    if keyword.iskeyword(name):
+        return "is a Python keyword, which generated code cannot use as a name"
+    if name.startswith("__") and name.endswith("__"):
+        return "is a special (dunder) name; choose another"
     return None
 
 

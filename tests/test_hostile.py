@@ -162,6 +162,11 @@ FILE_CASES = [
     ("nul-in-text", BASE.replace('name = "bob"', 'name = "b\\u0000b"'), RUN, 1,
      r"control characters"),
     ("unknown-case", BASE, RUN + ["--case", "\x1b[31mred"], 1, r"no case '\\x1b\[31mred'"),
+    ("joint-named-pi", BASE.replace('coordinates = ["theta"]\n', "").replace(
+        'name = "hinge"', 'name = "pi"').replace("theta = 0.5", "pi = 0.5"), RUN, 1,
+     r"joints\[0\].*'pi' is reserved"),
+    ("joint-named-lambda", BASE.replace('name = "hinge"', 'name = "lambda"'), RUN, 1,
+     r"joints\[0\].name.*Python keyword"),
     ("t-end-flag-huge", BASE, RUN + ["--t-end", "1e300"], 1, r"--t-end 1e300.*range"),
     ("t-end-flag-nan", BASE, RUN + ["--t-end", "nan"], 1, r"--t-end nan.*not a finite"),
     ("max-steps-fraction", BASE, RUN + ["--max-steps", "1.5"], 1, r"whole number"),

@@ -42,6 +42,7 @@ import warnings
 
 import numpy as np
 
+from .. import limits
 from ..errors import ModelError, SimulationError
 from .schedulers import make_scheduler
 
@@ -86,6 +87,9 @@ def parse_range(text, path="?"):
                              "whole number, e.g. 0.1:0.5:5") from None
         if n < 1:
             raise ModelError(f"grid {path}={text}: N = {n} gives no members; use N >= 1")
+        if n > limits.MAX_RANGE_POINTS:
+            raise ModelError(f"grid {path}={text}: N = {n} is more than "
+                             f"{limits.MAX_RANGE_POINTS} values on one axis")
         if how == "log":
             if a == 0 or b == 0 or (a > 0) != (b > 0):
                 raise ModelError(f"grid {path}={text}: log spacing needs START and STOP "
@@ -129,6 +133,10 @@ def expand(overrides=None, cases=None):
             if not values:
                 raise ModelError(f"grid {path}: no values; the sweep would have no members")
             axes.append([(path, v) for v in values])
+        size = math.prod(len(a) for a in axes) * max(1, len(cases or ()))
+        if size > limits.MAX_SWEEP_MEMBERS:
+            raise ModelError(f"the sweep would have {size} members, more than "
+                             f"{limits.MAX_SWEEP_MEMBERS}; split it into several sweeps")
         combos = [list(c) for c in itertools.product(*axes)]
     else:
         combos = [list(dict(m).items()) for m in overrides]

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import limits
 from ..errors import ModelError
 
 
@@ -43,6 +44,9 @@ def value_range(text):
             n = int(n[:-3] if log else n)
             if n < 2:
                 raise ValueError
+            if n > limits.MAX_RANGE_POINTS:
+                raise ModelError(f"--values {text!r}: {n} values are more than "
+                                 f"{limits.MAX_RANGE_POINTS}")
             if log:
                 return np.geomspace(float(start), float(stop), n)
             return np.linspace(float(start), float(stop), n)
