@@ -295,7 +295,12 @@ def make_drive(drive, element, parameters=None):
                          "parameters of the system or substitute numbers (expr.subs(...))")
     tsyms = [s for s in free if s.name == "t"]
     expr = expr.subs({s: t for s in tsyms})
-    funcs = [sympy.lambdify(t, e, "math") for e in (expr, expr.diff(t), expr.diff(t, 2))]
+    derivatives = (expr, expr.diff(t), expr.diff(t, 2))
+    if any(d.has(sympy.DiracDelta) for d in derivatives):
+        raise ModelError(f"{element}: the drive {expr} has a kink or a jump (its "
+                         "acceleration holds an impulse, DiracDelta); give a motion that is "
+                         "twice differentiable, e.g. smooth the corner")
+    funcs = [sympy.lambdify(t, e, "math") for e in derivatives]
     return Drive(*(_guarded(f, element, what) for f, what in zip(funcs, DRIVE_PARTS)),
                  expression=expr)
 

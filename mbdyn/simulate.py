@@ -350,6 +350,7 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     if not max_step > 0:
         raise ModelError(f"max_step must be positive, got {max_step!r}")
     budget = _budget(max_steps, max_samples, max_wall_time, decimate)
+    budget["drives"] = [d[0] for d in getattr(model, "_driven", ())]
     if t_eval is not None:
         t_eval = np.asarray(t_eval, dtype=float).reshape(-1)
         if not np.all(np.isfinite(t_eval)):
@@ -502,10 +503,13 @@ def _projected_over_budget(budget, steps, t, t_end, recent):
     projected = steps + (t_end - t) / h
     if projected <= budget["max_steps"]:
         return None
+    drives = budget.get("drives")
+    suspects = (f"; or the drive of {', '.join(map(repr, drives))} grows without bound or "
+                f"becomes singular near t={t:.6g}: check it" if drives else "")
     return (f"stopped at t={t:.6g} of {t_end:.6g} after {steps} steps: at its current step "
             f"size (median {h:.3g} s) the run would need about {projected:.2g} steps, more "
             f"than max_steps = {budget['max_steps']} -- a stiff model under an explicit "
-            "integrator takes tiny steps: try Radau or BDF; or raise max_steps "
+            f"integrator takes tiny steps: try Radau or BDF{suspects}; or raise max_steps "
             "(--max-steps)")
 
 

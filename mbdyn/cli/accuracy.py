@@ -1,15 +1,14 @@
 """``mbdyn accuracy MODEL``: what accuracy costs in time -- a work-precision study."""
 from __future__ import annotations
 
-import math
-
 import json
+import math
 import sys
 
 from ..analysis.accuracy import DEFAULT_INTEGRATORS, TOLERANCES, accuracy_study
 from ..errors import ModelError
 from ..simulate import INTEGRATORS
-from .common import add_model_arguments, load
+from .common import add_model_arguments, load, positive, positive_int
 
 
 def register(subparsers):
@@ -20,7 +19,7 @@ def register(subparsers):
                     "or step sizes (fixed-step); report error (max over time), energy drift, "
                     "wall time and right-hand-side evaluations.")
     add_model_arguments(p)
-    p.add_argument("--t-end", metavar="T", type=float,
+    p.add_argument("--t-end", metavar="T", type=positive,
                    help="end time (s; default the file's simulation.t_end)")
     p.add_argument("--integrators", metavar="LIST",
                    help="comma-separated, from " + ", ".join(INTEGRATORS)
@@ -31,9 +30,9 @@ def register(subparsers):
     p.add_argument("--steps", metavar="LIST",
                    help="comma-separated step sizes of the fixed-step sweep (default: "
                         "t_end/200 down to t_end/60000, aligned with the error samples)")
-    p.add_argument("--repeats", type=int, default=3, metavar="N",
+    p.add_argument("--repeats", type=positive_int, default=3, metavar="N",
                    help="timing repeats per run; the median is reported (default 3)")
-    p.add_argument("--budget", type=float, default=10.0, metavar="S",
+    p.add_argument("--budget", type=positive, default=10.0, metavar="S",
                    help="stop an integrator's sweep after a run slower than S seconds "
                         "(default 10)")
     p.add_argument("--json", action="store_true", help="print one JSON object and nothing else")

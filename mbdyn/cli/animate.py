@@ -8,7 +8,7 @@ from __future__ import annotations
 import os
 import sys
 
-from .common import Progress, add_model_arguments, load
+from .common import add_model_arguments, load, positive, Progress
 
 
 def register(subparsers):
@@ -21,9 +21,9 @@ def register(subparsers):
     add_model_arguments(p)
     p.add_argument("--out", metavar="FILE", help=".gif, .mp4 (needs the video extra) or "
                                                  ".html (default STEM.gif)")
-    p.add_argument("--speed", type=float, default=1.0, help="playback speed (default 1: "
+    p.add_argument("--speed", type=positive, default=1.0, help="playback speed (default 1: "
                                                             "real time)")
-    p.add_argument("--fps", type=float, default=30.0, help="frames per second (default 30)")
+    p.add_argument("--fps", type=positive, default=30.0, help="frames per second (default 30)")
     p.set_defaults(func=run)
 
 

@@ -43,6 +43,8 @@ def run(args):
         orders = [int(o) for o in names(args.orders)]
     except ValueError:
         raise ModelError(f"--orders {args.orders!r}: give integers, e.g. 1,2") from None
+    if not orders or any(o < 1 for o in orders):
+        raise ModelError(f"--orders {args.orders!r}: give whole numbers >= 1, e.g. 1,2")
     cb = campbell(scene, args.parameter, value_range(args.values), orders=orders,
                   whirl=whirl_pairs(args), at=args.at, fixed=names(args.fixed),
                   spin_is_parameter=not args.not_spin)

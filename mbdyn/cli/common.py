@@ -1,6 +1,8 @@
 """Arguments and helpers shared by the ``mbdyn`` commands."""
 from __future__ import annotations
 
+import argparse
+import math
 import sys
 import time
 import warnings
@@ -8,6 +10,36 @@ import warnings
 from ..io.errors import ModelFileError
 from ..io.loader import load_model
 from ..io.schema import parse_set_value
+
+
+def finite(text):
+    """argparse type: a finite number."""
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not math.isfinite(v):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+    return v
+
+
+def positive(text):
+    """argparse type: a finite number > 0."""
+    v = finite(text)
+    if not v > 0:
+        raise argparse.ArgumentTypeError(f"{text!r} is not > 0")
+    return v
+
+
+def positive_int(text):
+    """argparse type: a whole number >= 1."""
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} is not >= 1")
+    return v
 
 
 def add_model_arguments(parser):

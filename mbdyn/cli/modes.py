@@ -9,7 +9,7 @@ from __future__ import annotations
 import json
 import sys
 
-from .common import add_model_arguments, load
+from .common import add_model_arguments, load, positive, positive_int
 from .vibration_args import add_vibration_arguments, names, whirl_pairs
 
 
@@ -27,9 +27,9 @@ def register(subparsers):
     p.add_argument("--matrices", action="store_true", help="also print M, D, G, K, N")
     p.add_argument("--animate", metavar="FILE", help="animate a mode shape about the "
                    "operating point: .gif, .mp4 or .html")
-    p.add_argument("--mode", type=int, default=1, metavar="K",
+    p.add_argument("--mode", type=positive_int, default=1, metavar="K",
                    help="which mode --animate draws (1 = the lowest, as listed)")
-    p.add_argument("--amplitude", type=float, default=0.1,
+    p.add_argument("--amplitude", type=positive, default=0.1,
                    help="--animate's amplitude in the tangent coordinates (rad or m)")
     add_vibration_arguments(p)
     p.set_defaults(func=run)

@@ -9,8 +9,8 @@ import sys
 
 from ..analysis.sweep import DEFAULT_QUANTITIES, parse_grid, sweep
 from ..errors import ModelError
-from .common import fmt
 from ..io.schema import parse_set_value
+from .common import fmt, positive_int
 
 
 def register(subparsers):
@@ -35,7 +35,7 @@ def register(subparsers):
     p.add_argument("--scheduler", default="serial", metavar="WHERE",
                    help="serial (default), processes, dask (a local Dask cluster) or "
                         "tcp://HOST:PORT (an existing Dask scheduler)")
-    p.add_argument("--workers", type=int, metavar="N", help="local worker processes")
+    p.add_argument("--workers", type=positive_int, metavar="N", help="local worker processes")
     p.add_argument("--batched", action="store_true",
                    help="advance members in one compiled call (fixed-step, no events)")
     p.add_argument("--out", metavar="FILE", help="the table (.csv, or .parquet with pyarrow); "

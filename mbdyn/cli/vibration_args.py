@@ -5,13 +5,14 @@ import numpy as np
 
 from .. import limits
 from ..errors import ModelError
+from .common import finite
 
 
 def add_vibration_arguments(p, whirl=True):
     p.add_argument("--fixed", metavar="NAMES", default="",
                    help="coordinates or joints held at their initial values (comma-separated),"
                         " e.g. a cyclic spin angle")
-    p.add_argument("--t", type=float, default=0.0, metavar="T",
+    p.add_argument("--t", type=finite, default=0.0, metavar="T",
                    help="time of the operating point (drives, time-dependent loads)")
     if whirl:
         p.add_argument("--whirl", metavar="Y,Z", action="append", default=[],
@@ -34,6 +35,11 @@ def whirl_pairs(args):
     return pairs
 
 
+def _too_many(text, n):
+    raise ModelError(f"--values {text!r}: {n} values are more than {limits.MAX_RANGE_POINTS}; "
+                     "give fewer")
+
+
 def value_range(text):
     """``START:STOP:N`` (linear), ``START:STOP:Nlog`` (logarithmic) or ``a,b,c``."""
     text = str(text).strip()
@@ -45,12 +51,13 @@ def value_range(text):
             if n < 2:
                 raise ValueError
             if n > limits.MAX_RANGE_POINTS:
-                raise ModelError(f"--values {text!r}: {n} values are more than "
-                                 f"{limits.MAX_RANGE_POINTS}")
+                return _too_many(text, n)
             if log:
                 return np.geomspace(float(start), float(stop), n)
             return np.linspace(float(start), float(stop), n)
         values = np.array([float(v) for v in text.split(",")])
+    except ModelError:
+        raise
     except ValueError:
         raise ModelError(f"--values {text!r}: give START:STOP:N (N >= 2), START:STOP:Nlog "
                          "or a comma-separated list of numbers") from None

@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ModelError
+
 #: colours of a frame's x, y, z axes (red, green, blue)
 AXES = ("#e41a1c", "#4daf4a", "#377eb8")
 PALETTE = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
@@ -120,7 +122,8 @@ def sample_times(result, fps=30.0, speed=1.0, max_frames=None):
     t0, t1 = float(result.t[0]), float(result.t[-1])
     n = int(np.floor((t1 - t0) / speed * fps + 1e-9)) + 1
     if max_frames is not None and n > max_frames:
-        n = max_frames
+        raise ModelError(f"the animation would need {n} frames ((t_end - t0) / speed x fps), "
+                         f"more than {max_frames}; raise the speed or lower the fps")
     return t0 + np.arange(n) * speed / fps if n > 1 else np.array([t0])
 
 
