@@ -359,6 +359,15 @@ class Model:
         return self._vector(values, np.zeros(self.nu), self._speed_index, "speed")
 
     def _vector(self, values, default, index, what):
+        try:
+            return self._vector_of(values, default, index, what)
+        except ModelError:
+            raise
+        except (TypeError, ValueError):
+            raise ModelError(f"the {what}s must be numbers, given as an array or as "
+                             f"{{name: value}}; got {values!r}") from None
+
+    def _vector_of(self, values, default, index, what):
         if values is None:
             return default
         if isinstance(values, dict):
@@ -412,8 +421,7 @@ class Model:
     def _fill(self, q, u, t):
         """Scatter the free state and the drives into joint-space vectors; evaluate the
         loads that are functions of ``(t, q, u)``."""
-        q = np.asarray(q, dtype=float)
-        u = np.asarray(u, dtype=float)
+        q, u = self._as_arrays(q, u)
         if q.shape != (self.nq,) or u.shape != (self.nu,):
             raise ModelError(f"model {self.name!r} expects q of length {self.nq} and u of "
                              f"length {self.nu}, got {q.shape} and {u.shape}")
@@ -427,6 +435,13 @@ class Model:
         self._fill_inputs(q, u, t)
         return q, u
 
+    def _as_arrays(self, q, u):
+        try:
+            return np.asarray(q, dtype=float), np.asarray(u, dtype=float)
+        except (TypeError, ValueError):
+            raise ModelError(f"model {self.name!r}: q and u must be arrays of numbers "
+                             f"(q: {self.nq} coordinates, u: {self.nu} speeds)") from None
+
     def _require_finite(self, q, u, t=0.0):
         """``NonFiniteError`` naming the coordinates and speeds that are NaN or Inf."""
         bad = [n for n, x in zip(self.coordinates + self.speeds,
@@ -438,8 +453,7 @@ class Model:
                                  "speeds")
 
     def _state(self, q, u):
-        q = np.asarray(q, dtype=float)
-        u = np.asarray(u, dtype=float)
+        q, u = self._as_arrays(q, u)
         if q.shape != (self.nq,) or u.shape != (self.nu,):
             raise ModelError(f"model {self.name!r} expects q of length {self.nq} and u of "
                              f"length {self.nu}, got {q.shape} and {u.shape}")

@@ -391,6 +391,10 @@ def _default_names(name, kind, coordinates, speeds, element):
         un = tuple(f"{name}_{k}" for k in ("vx", "vy", "vz", "wx", "wy", "wz"))
     else:
         un = ()
+    repeated = sorted({n for n in qn + un if (qn + un).count(n) > 1})
+    if repeated:
+        raise ModelError(f"{element}: the names {repeated} are given to more than one of its "
+                         "coordinates and speeds; give each its own name")
     for n in qn + un:
         problem = identifier_problem(n)
         if problem:

@@ -119,6 +119,9 @@ def as_event(e, model):
         e = Event(*e)
     elif not isinstance(e, Event):
         raise ModelError(f"event {e!r}: give an mb.Event(name, condition, terminal, direction)")
+    if e.direction not in (None, 0, 1, -1):
+        raise ModelError(f"event {e.name!r}: direction must be +1 (rising), -1 (falling) or "
+                         f"0 (either), got {e.direction!r}")
     g, implied = compile_condition(e.condition, model, e.name)
     direction = e.direction
     if implied is not None:

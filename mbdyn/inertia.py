@@ -5,6 +5,16 @@ results are 3x3 tensors in body axes (kg m^2).
 """
 import numpy as np
 
+from .errors import ModelError
+
+
+def _nonnegative(shape, **values):
+    """Refuse a negative (or non-finite) mass or dimension of a shape helper; sympy symbols
+    pass (their sign is the user's to keep)."""
+    for name, v in values.items():
+        if isinstance(v, (int, float, np.number)) and not (np.isfinite(v) and v >= 0):
+            raise ModelError(f"inertia.{shape}: {name} must be a finite number >= 0, got {v!r}")
+
 
 def _axis_index(axis):
     return {"x": 0, "y": 1, "z": 2}[axis]
@@ -18,26 +28,31 @@ def _symmetric(mass, axial, transverse, axis):
 
 def disk(mass, radius, axis="z"):
     """Thin uniform disk: ``m r^2/2`` about its axis, ``m r^2/4`` across."""
+    _nonnegative('disk', mass=mass, radius=radius)
     return _symmetric(mass, mass * radius**2 / 2, mass * radius**2 / 4, axis)
 
 
 def cylinder(mass, radius, length, axis="z"):
     """Solid uniform cylinder: ``m r^2/2`` about its axis, ``m (3 r^2 + L^2)/12`` across."""
+    _nonnegative('cylinder', mass=mass, radius=radius, length=length)
     return _symmetric(mass, mass * radius**2 / 2, mass * (3 * radius**2 + length**2) / 12, axis)
 
 
 def rod(mass, length, axis="z"):
     """Slender uniform rod along ``axis``: 0 about it, ``m L^2/12`` across."""
+    _nonnegative('rod', mass=mass, length=length)
     return _symmetric(mass, 0.0, mass * length**2 / 12, axis)
 
 
 def sphere(mass, radius):
     """Solid uniform sphere: ``2 m r^2/5`` about any axis."""
+    _nonnegative('sphere', mass=mass, radius=radius)
     return np.eye(3) * (2 * mass * radius**2 / 5)
 
 
 def box(mass, a, b, c):
     """Solid uniform box with edges ``a, b, c`` along body x, y, z."""
+    _nonnegative('box', mass=mass, a=a, b=b, c=c)
     return np.diag([b * b + c * c, a * a + c * c, a * a + b * b]) * (mass / 12)
 
 

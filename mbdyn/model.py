@@ -47,7 +47,11 @@ class System:
                                  f"got {value!r}") from None
         self.gravity_symbolic = gravity if has_symbols(gravity) else None
         gravity = numeric(gravity, self.parameters, f"system {name!r}", "gravity")
-        g = np.asarray(gravity, dtype=float).reshape(-1)
+        try:
+            g = np.asarray(gravity, dtype=float).reshape(-1)
+        except (TypeError, ValueError):
+            raise ModelError(f"system {name!r}: gravity must be three finite numbers, "
+                             f"got {gravity!r}") from None
         if g.shape != (3,) or not np.all(np.isfinite(g)):
             raise ModelError(f"system {name!r}: gravity must be three finite numbers, "
                              f"got {gravity!r}")

@@ -43,7 +43,12 @@ def from_euler(angles, sequence="ZXZ"):
 
 def to_matrix(q):
     """The rotation matrix of a unit quaternion (child to parent components)."""
-    w, x, y, z = np.asarray(q, dtype=float) / np.linalg.norm(q)
+    q = np.asarray(q, dtype=float)
+    n = np.linalg.norm(q)
+    if q.shape != (4,) or not (np.isfinite(n) and n > 0):
+        raise ModelError(f"to_matrix: {q.tolist()} is not a quaternion (four finite numbers, "
+                         "not all zero)")
+    w, x, y, z = q / n
     return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
                      [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
                      [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])

@@ -98,7 +98,11 @@ class Result:
         import os
         import tempfile
         directory = os.path.dirname(os.path.abspath(path))
-        fd, tmp = tempfile.mkstemp(prefix=".result.", suffix=".csv", dir=directory)
+        try:
+            fd, tmp = tempfile.mkstemp(prefix=".result.", suffix=".csv", dir=directory)
+        except OSError as exc:
+            raise OSError(exc.errno, f"cannot write {path}: {exc.strerror}", str(path)) \
+                from None
         try:
             with os.fdopen(fd, "w") as fh:
                 fh.write(buf.getvalue())
@@ -339,7 +343,13 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     if method not in ("jourdain", "newton-euler", "symbolic"):
         raise ModelError(f"unknown method {method!r}; use 'jourdain', 'newton-euler' or "
                          "'symbolic'")
-    t0, t_end = float(t0), float(t_end)
+    try:
+        t0, t_end = float(t0), float(t_end)
+    except (TypeError, ValueError):
+        raise ModelError(f"t0 and t_end must be numbers, got {t0!r} and {t_end!r}") from None
+    if isinstance(events, (str, Event)):
+        raise ModelError("events must be a list of mb.Event, e.g. events=[mb.Event('stop', "
+                         "'theta >= 1', terminal=True)]")
     if not (np.isfinite(t0) and np.isfinite(t_end)):
         raise ModelError(f"t0 and t_end must be finite, got {t0} and {t_end}")
     if not t_end > t0:
@@ -352,7 +362,12 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     budget = _budget(max_steps, max_samples, max_wall_time, decimate)
     budget["drives"] = [d[0] for d in getattr(model, "_driven", ())]
     if t_eval is not None:
-        t_eval = np.asarray(t_eval, dtype=float).reshape(-1)
+        try:
+            t_eval = np.asarray(t_eval, dtype=float).reshape(-1)
+        except (TypeError, ValueError):
+            raise ModelError("t_eval must be a sequence of times (numbers)") from None
+        if not t_eval.size:
+            raise ModelError("t_eval is empty; give the output times, or None for every step")
         if not np.all(np.isfinite(t_eval)):
             raise ModelError("t_eval holds NaN or infinite times; give finite output times")
         if np.any(np.diff(t_eval) <= 0):
@@ -498,8 +513,8 @@ PROJECTION_STEPS = 1000
 def _projected_over_budget(budget, steps, t, t_end, recent):
     """Stop early a run that cannot finish within ``max_steps`` at its current pace."""
     h = float(np.median(recent))
-    if not h > 0:
-        return None
+    if not h > 1e4 * np.finfo(float).eps * max(1.0, abs(t)):
+        return None     # at the rounding limit: the integrator's own failure follows, precisely
     projected = steps + (t_end - t) / h
     if projected <= budget["max_steps"]:
         return None

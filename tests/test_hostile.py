@@ -172,8 +172,19 @@ FILE_CASES = [
     ("max-steps-fraction", BASE, RUN + ["--max-steps", "1.5"], 1, r"whole number"),
     ("output-dt-below-dt", model_text() + 'integrator = "rk4"\ndt = 0.01\noutput_dt = 1e-3\n',
      RUN, 0, r"output_dt.*smaller than dt"),
-    ("accuracy-t-end-nan", BASE, ["accuracy", "{model}", "--t-end", "nan"], 1,
-     r"--t-end nan"),
+    ("accuracy-t-end-nan", BASE, ["accuracy", "{model}", "--t-end", "nan"], 2,
+     r"--t-end: 'nan' is not a finite number"),
+    ("modes-amplitude-nan", BASE, ["modes", "{model}", "--amplitude", "nan"], 2,
+     r"--amplitude: 'nan'"),
+    ("sweep-workers-negative", BASE, ["sweep", "{model}", "--grid", "parameters.l=1:2:2",
+                                      "--workers", "-3"], 2, r"--workers: '-3' is not >= 1"),
+    ("sweep-too-many-members", BASE, ["sweep", "{model}", "--grid", "parameters.l=1:2:99999",
+                                      "--grid", "parameters.m=1:2:99999"], 1,
+     r"members, more than"),
+    ("campbell-too-many-values", BASE, ["campbell", "{model}", "--parameter", "l", "--values",
+                                        "1:2:1000000000"], 1, r"more than 100000"),
+    ("animate-too-many-frames", BASE, ["animate", "{model}", "--out", "{tmp}/a.gif",
+                                       "--speed", "1e-9"], 1, r"frames.*raise the speed"),
 ]
 
 
@@ -241,7 +252,7 @@ API_CASES = [
      mb.ModelError, r"max_steps"),
     ("dt-nan", lambda: mb.simulate(_pendulum(), 1.0, integrator="rk4", dt=float("nan")),
      mb.ModelError, r"dt > 0"),
-    ("samples", lambda: mb.simulate(_pendulum(), 1e4, integrator="euler", dt=1e-3),
+    ("samples", lambda: mb.simulate(_pendulum(), 4e3, integrator="euler", dt=1e-3),
      mb.ModelError, r"max_samples"),
     ("budget-bad", lambda: mb.simulate(_pendulum(), 1.0, max_steps=0), mb.ModelError,
      r"max_steps must be a positive whole number"),
@@ -263,13 +274,41 @@ API_CASES = [
      r"control characters"),
     ("fullwidth-parameter", lambda: mb.System("s", parameters={"\uff4d": 1.0}),
      mb.ModelError, r"ASCII"),
+    ("gravity-text", lambda: mb.System("s", gravity="down"), mb.ModelError, r"gravity"),
+    ("q0-text", lambda: mb.simulate(_pendulum(), 1.0, q0={"hinge": "abc"}), mb.ModelError,
+     r"coordinates must be numbers"),
+    ("q-text", lambda: _pendulum().compile().forward_dynamics("abc", np.zeros(1)),
+     mb.ModelError, r"arrays of numbers"),
+    ("t-end-text", lambda: mb.simulate(_pendulum(), "soon"), mb.ModelError, r"t_end"),
+    ("t-eval-empty", lambda: mb.simulate(_pendulum(), 1.0, t_eval=[]), mb.ModelError,
+     r"t_eval is empty"),
+    ("events-text", lambda: mb.simulate(_pendulum(), 1.0, events="hinge > 1"),
+     mb.ModelError, r"list of mb.Event"),
+    ("event-direction", lambda: mb.simulate(_pendulum(), 1.0, events=[
+        mb.Event("e", "hinge > 1", direction=5)]), mb.ModelError, r"direction"),
+    ("zero-quaternion-matrix", lambda: mb.rotations.to_matrix([0, 0, 0, 0]), mb.ModelError,
+     r"not a quaternion"),
+    ("negative-mass-helper", lambda: mb.inertia.sphere(-1.0, 0.1), mb.ModelError,
+     r"sphere: mass"),
+    ("coordinate-named-t", lambda: _second_link(["t"]), mb.ModelError, r"'t' is reserved"),
+    ("speed-same-as-coordinate", lambda: _second_link(["a"], speeds=["a"]), mb.ModelError,
+     r"more than one"),
+    ("drive-with-kink", lambda: _drive_system(abs(mb.t - 0.5)), mb.ModelError,
+     r"kink or a jump"),
+    ("load-model-number", lambda: mb.load_model(123), mb.ModelError, r"path"),
+    ("load-model-overrides-text", lambda: mb.load_model(
+        os.path.join(ROOT, "models", "top.toml"), overrides="parameters.Mz=1"),
+     mb.ModelError, r"overrides must be a mapping"),
+    ("csv-unwritable", lambda: mb.simulate(_pendulum(), 0.1).to_csv("/proc/nope/x.csv"),
+     OSError, r"cannot write /proc/nope/x.csv"),
 ]
 
 
-def _second_link(coordinates):
+def _second_link(coordinates, speeds=None):
     s = _pendulum()
     s.add_body("bob2", mass=1.0, com=(0.5, 0, 0))
-    s.add_joint("j2", "revolute", "bob", "bob2", axis="z", coordinates=coordinates)
+    s.add_joint("j2", "revolute", "bob", "bob2", axis="z", coordinates=coordinates,
+                speeds=speeds)
 
 
 def _drive_system(expr):

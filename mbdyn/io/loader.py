@@ -153,6 +153,11 @@ def load_model(path, case=None, overrides=None, effects=None):
     ``--effects`` takes them (``"-gravity,-damper"``, a list, or a mapping; see
     ``mbdyn.effects``).  Raises ``ModelFileError`` (a ``ModelError``) naming file and key.
     """
+    if not isinstance(path, (str, os.PathLike)):
+        raise ModelError(f"load_model: path must be the path of a .toml file, got {path!r}")
+    if isinstance(overrides, str):
+        raise ModelError("load_model: overrides must be a mapping {\"parameters.k\": 1.0} or "
+                         "a list of \"PATH=VALUE\" texts, not one string")
     doc = read_document(path)
     checker = Checker(path)
     checker.check_document(doc)
