@@ -25,6 +25,9 @@ def parse_effects(spec, known, where="effects", base=None):
     Unknown names are an error that lists the known ones.
     """
     state = {name: True for name in known} if base is None else dict(base)
+    if spec is not None and not isinstance(spec, (str, dict, list, tuple, set)):
+        raise ModelError(f"{where}: give effects as \"-gravity,-damper\", a list of such "
+                         f"names or a mapping {{name: on}}, not {spec!r}")
     if spec is None:
         return state
 

@@ -24,6 +24,11 @@ class Event:
     terminal: bool = False
     direction: int | None = 0
 
+    def __post_init__(self):
+        if self.direction not in (None, 0, 1, -1):
+            raise ModelError(f"event {self.name!r}: direction must be +1 (rising), -1 "
+                             f"(falling) or 0 (either), got {self.direction!r}")
+
 
 class EventRecord(tuple):
     """An event that occurred: unpacks as ``(name, t)`` (``for name, t in res.events``),

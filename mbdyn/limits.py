@@ -20,6 +20,8 @@ MAX_NESTING = 16
 #: magnitude of any number written in a model file or given as a value (beyond it,
 #: products overflow double precision; no SI quantity of a mechanism comes near)
 MAX_MAGNITUDE = 1e100
+#: the smallest non-zero magnitude (below it, squares underflow to zero)
+MIN_MAGNITUDE = 1e-100
 #: decimal digits of an integer literal (a float holds ~17)
 MAX_INTEGER_DIGITS = 40
 #: characters of one expression, its parse-tree nodes and the depth of its nesting

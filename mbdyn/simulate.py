@@ -378,10 +378,21 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
             raise ModelError(f"t_eval has times outside t0..t_end = {t0:g}..{t_end:g} (e.g. "
                              f"{outside[0]:g}); they would be dropped -- raise t_end or remove "
                              "them")
-    q = model.q_vector(None if q0 is None else (dict(q0) if isinstance(q0, dict) else q0)).copy()
-    u = model.u_vector(None if u0 is None else (dict(u0) if isinstance(u0, dict) else u0)).copy()
+    try:
+        q = model.q_vector(None if q0 is None else (dict(q0) if isinstance(q0, dict)
+                                                    else q0)).copy()
+    except ModelError as exc:
+        raise ModelError(f"q0: {exc}") from None
+    try:
+        u = model.u_vector(None if u0 is None else (dict(u0) if isinstance(u0, dict)
+                                                    else u0)).copy()
+    except ModelError as exc:
+        raise ModelError(f"u0: {exc}") from None
     if not (np.all(np.isfinite(q)) and np.all(np.isfinite(u))):
-        raise ModelError("initial state must be finite")
+        bad = [n for n, v in zip(model.coordinates + model.speeds, np.concatenate([q, u]))
+               if not np.isfinite(v)]
+        raise ModelError(f"initial state must be finite: q0/u0 hold NaN or Inf in "
+                         f"{', '.join(bad)}")
     model.normalize_quaternions(q)
     events = [as_event(e, model) for e in events]
     if events:

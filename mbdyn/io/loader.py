@@ -351,6 +351,10 @@ class _SceneBuilder:
         return e if e.free_symbols else v
 
     def bounded(self, v, path):
+        if v != 0 and abs(v) < limits.MIN_MAGNITUDE:
+            raise self.error(path, f"{v:g} is below the range mbdyn accepts (0 or |x| >= "
+                             f"{limits.MIN_MAGNITUDE:g}; its square underflows); check the "
+                             "units, or write 0")
         if abs(v) > limits.MAX_MAGNITUDE:
             raise self.error(path, f"{v:g} is beyond the range mbdyn accepts (|x| <= "
                              f"{limits.MAX_MAGNITUDE:g}; products of such numbers overflow); "
@@ -715,6 +719,20 @@ class _SceneBuilder:
         if s["integrator"] in FIXED_STEP and not s.get("dt"):
             raise self.error(path + ("integrator",), f"{s['integrator']!r} is a fixed-step "
                              "integrator: add dt = ... to [simulation] (or pass --dt)")
+        if s["integrator"] in FIXED_STEP:
+            ignored = [k for k in ("rtol", "atol", "max_step") if k in sim]
+            if ignored:
+                warnings.warn(f"simulation.{', simulation.'.join(ignored)} ignored: the "
+                              f"fixed-step integrator {s['integrator']} takes steps of dt",
+                              ModelWarning)
+            if s.get("t_end") and s["dt"] > s["t_end"]:
+                warnings.warn(f"simulation.dt = {s['dt']:g} is longer than t_end = "
+                              f"{s['t_end']:g}: the run is one shortened step", ModelWarning)
+            ratio = s["output_dt"] / s["dt"] if s.get("output_dt") else 1.0
+            if ratio >= 1 and abs(ratio - round(ratio)) > 1e-6 * ratio:
+                warnings.warn(f"simulation.output_dt = {s['output_dt']:g} is not a multiple of "
+                              f"dt = {s['dt']:g}: every {round(ratio)}-th step is kept "
+                              f"(every {round(ratio) * s['dt']:g} s)", ModelWarning)
         if (s["integrator"] in FIXED_STEP and s.get("output_dt")
                 and s["output_dt"] < s["dt"] * (1 - 1e-9)):
             warnings.warn(f"simulation.output_dt = {s['output_dt']:g} is smaller than dt = "
