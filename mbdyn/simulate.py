@@ -117,6 +117,18 @@ class Result:
         raise KeyError(f"{name!r} is neither a coordinate ({', '.join(self.coordinates)}) nor a "
                        f"speed ({', '.join(self.speeds)}) of model {self.model.name!r}")
 
+    def plot(self, series=None, phase=None, out=None, title=None):
+        """Time series or a phase portrait of this result: see ``mbdyn.viz.plot_result``
+        (imported on call, as matplotlib is)."""
+        from .viz import plot_result
+        return plot_result(self, series=series, phase=phase, out=out, title=title)
+
+    def animate(self, out, speed=1.0, fps=30.0, title=None, **options):
+        """An animation of this result written to ``out``: see ``mbdyn.viz.animate``
+        (imported on call)."""
+        from .viz import animate
+        return animate(self, out, speed=speed, fps=fps, title=title, **options)
+
     def __repr__(self):
         return (f"<Result {self.model.name!r}: {len(self.t)} samples, t = {self.t[0]:g} .. "
                 f"{self.t[-1]:g}, events {self.events}>")
