@@ -547,7 +547,8 @@ def _fixed_chunks(rhs, integrator, t0, t_end, y0, dt, compiled, events=()):
     y = y0.copy()
     t = t0
     if compiled:
-        from .kernels.integrators import SCHEMES, STAGES, fixed_step_loop
+        from .kernels.integrators import LOOPS, SCHEMES, STAGES
+        loop = LOOPS[SCHEMES[integrator]]
         args = model.loop_arguments()
         # stretches between checks of events and singularities: short when there are
         # some (a terminal event wastes at most a stretch), long otherwise
@@ -560,8 +561,7 @@ def _fixed_chunks(rhs, integrator, t0, t_end, y0, dt, compiled, events=()):
                 table = model.drive_values(stage_times).reshape(len(tk), len(STAGES), -1, 3)
                 out = np.empty((len(tk) + 1, y.size))
                 nfev = np.zeros(1, np.int64)
-                done, status = fixed_step_loop(SCHEMES[integrator], h, y, table, *args, out,
-                                               nfev)
+                done, status = loop(h, y, table, *args, out, nfev)
                 rhs.evaluations += int(nfev[0])
                 failure = None
                 if status:
