@@ -3,29 +3,33 @@
 Assemble bodies, frames and joints into a tree (``System``), compile it to a ``Model``,
 evaluate kinematics, Jacobians, the Newton-Euler-Jourdain form ``M(q) u' = f`` or the
 Newton-Euler system with reactions, and integrate with ``simulate``.
+
+``import mbdyn`` is cheap: it neither imports numpy, numba, scipy or sympy nor compiles
+anything.  Each public name is imported from its module on first use (PEP 562), so
+``mb.System``, ``mb.derive`` or ``mb.viz`` load only what they need.
 """
-from . import effects, forces, inertia, rotations
-from .compile import Kinematics, Model
-from .elements import t
-from .errors import (ModelError, ModelWarning, NonFiniteError, SimulationError,
-                     SingularityWarning, SingularMassMatrixError)
-from .model import GROUND, System
-from .simulate import FIXED_STEP, INTEGRATORS, Event, Result, simulate
-from .io import ModelFileError, Scene, load_model
-from .symbolic import derive
-from .analysis import (Campbell, Equilibrium, EquilibriumError, Linearization, Modes,
-                       campbell, equilibrium, linearize, modes)
-from .analysis.sweep import SweepResult, sweep
-
-from . import viz
-
-#: ``Result.plot(series=None, phase=None, out=None)``: see ``mbdyn.viz.plot_result``
-Result.plot = viz.plot_result
-#: ``Result.animate(out, speed=1.0, fps=30.0)``: see ``mbdyn.viz.animate``
-Result.animate = viz.animate
+import importlib
+import types
 
 __version__ = "0.1.0"
 
+#: public name -> the module that defines it (relative to this package)
+_PUBLIC = {
+    "System": ".model", "GROUND": ".model",
+    "Model": ".compile", "Kinematics": ".compile",
+    "Result": ".simulate", "Event": ".simulate", "simulate": ".simulate",
+    "INTEGRATORS": ".simulate", "FIXED_STEP": ".simulate",
+    "t": ".elements",
+    "ModelError": ".errors", "ModelWarning": ".errors", "NonFiniteError": ".errors",
+    "SimulationError": ".errors", "SingularityWarning": ".errors",
+    "SingularMassMatrixError": ".errors",
+    "load_model": ".io", "Scene": ".io", "ModelFileError": ".io",
+    "derive": ".symbolic",
+    "equilibrium": ".analysis", "linearize": ".analysis", "modes": ".analysis",
+    "campbell": ".analysis", "Equilibrium": ".analysis", "EquilibriumError": ".analysis",
+    "Linearization": ".analysis", "Modes": ".analysis", "Campbell": ".analysis",
+    "sweep": ".analysis.sweep", "SweepResult": ".analysis.sweep",
+}
 __all__ = ["System", "Model", "Kinematics", "Result", "Event", "simulate", "inertia", "t",
            "GROUND", "INTEGRATORS", "FIXED_STEP", "ModelError", "ModelWarning",
            "NonFiniteError", "SimulationError", "SingularityWarning",
@@ -33,3 +37,35 @@ __all__ = ["System", "Model", "Kinematics", "Result", "Event", "simulate", "iner
            "forces", "effects", "rotations", "equilibrium", "linearize", "modes", "campbell",
            "Equilibrium", "EquilibriumError", "Linearization", "Modes", "Campbell",
            "sweep", "SweepResult"]
+
+
+def __getattr__(name):
+    """Import a public name (or a submodule such as ``viz``) on first use."""
+    if name in _PUBLIC:
+        value = getattr(importlib.import_module(_PUBLIC[name], __name__), name)
+    else:
+        try:
+            value = importlib.import_module(f".{name}", __name__)
+        except ModuleNotFoundError as exc:
+            if exc.name != f"{__name__}.{name}":
+                raise
+            raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))
+
+
+class _Package(types.ModuleType):
+    """The package's module type: importing the submodule ``mbdyn.simulate`` binds it as
+    the package attribute ``simulate``; the public name is the function, as before."""
+
+    def __setattr__(self, name, value):
+        if name == "simulate" and isinstance(value, types.ModuleType):
+            value = value.simulate
+        super().__setattr__(name, value)
+
+
+__import__("sys").modules[__name__].__class__ = _Package

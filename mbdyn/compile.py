@@ -634,6 +634,19 @@ class Model:
             return self._newton_euler(q, u, t)[:self.nu].copy()
         raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")
 
+    def _check_at_rest(self, q, t=0.0):
+        """Raise what ``forward_dynamics(q, 0, t)`` raises -- ``SingularMassMatrixError``
+        or ``NonFiniteError`` -- by the same Cholesky solve of ``M u' = f``, called on the
+        terms ``mass_matrix`` computes; returns nothing.  Used when a system is compiled:
+        this way the check needs no compiled entry point of its own (a first run compiles
+        less)."""
+        q, u = self._state(q, np.zeros(self.nu))
+        self._jourdain_terms(q, u, t)
+        pivot = kd.cholesky_solve(self._M, self._f, self._L, self._ud)
+        if pivot >= 0:
+            self._raise_singular(q, t, pivot)
+        self._check_finite(q, u, t, self._ud, "the accelerations")
+
     def state_derivative(self, t, y):
         """``[q', u']`` for the state ``y = [q, u]`` by the Jourdain formulation, in one
         compiled call: ``q' = N(q) u`` (``coordinate_rates``) and ``u'`` from
@@ -654,12 +667,25 @@ class Model:
                                rates)
         return ydot
 
-    def _newton_euler(self, q, u, t):
+    def _newton_euler(self, q, u, t, packed=True):
+        """The Newton-Euler unknowns ``[u', reactions]`` and whether all are finite.
+        ``packed``: one call on the packed buffers (cheapest per call, for right-hand
+        sides); else the same kernel on the arrays (``newton_euler``, ``reactions``: a
+        run that only evaluates reactions at its output points compiles less)."""
         q, u = self._state(q, u)
-        if self._python_inputs:
-            self._fill_inputs(q, u, t)
         try:
-            x, finite = kp.newton_euler_solution_packed(*self._packed, q, u)
+            if packed:
+                if self._python_inputs:
+                    self._fill_inputs(q, u, t)
+                x, finite = kp.newton_euler_solution_packed(*self._packed, q, u)
+            else:
+                self._fill(q, u, t)
+                x = ke.newton_euler_solution(
+                    *self._tree, self._mass, self._com, self._inertia, self.gravity,
+                    self._qfull, self._ufull, self._udfull, *self._loads_arrays,
+                    self._react_joint, self._react_force, self._react_moment,
+                    *self._kin_out, self._A, self._b)
+                finite = bool(np.all(np.isfinite(x)))
         except np.linalg.LinAlgError:     # singular, or fed NaN/Inf: tell which
             self._jourdain_terms(q, u, t)
             for out in (self._f, np.diag(self._M)):
@@ -699,7 +725,7 @@ class Model:
 
         Returns ``(ud, reactions)``; ``reactions`` as in ``Model.reactions``.
         """
-        x = self._newton_euler(q, u, t)
+        x = self._newton_euler(q, u, t, packed=False)
         return x[:self.nu].copy(), self._reactions_from(x[self.nu:])
 
     def _reactions_from(self, lam):

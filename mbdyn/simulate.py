@@ -123,6 +123,18 @@ class Result:
         raise KeyError(f"{name!r} is neither a coordinate ({', '.join(self.coordinates)}) nor a "
                        f"speed ({', '.join(self.speeds)}) of model {self.model.name!r}")
 
+    def plot(self, series=None, phase=None, out=None, title=None):
+        """Time series or a phase portrait of this result: see ``mbdyn.viz.plot_result``
+        (imported on call, as matplotlib is)."""
+        from .viz import plot_result
+        return plot_result(self, series=series, phase=phase, out=out, title=title)
+
+    def animate(self, out, speed=1.0, fps=30.0, title=None, **options):
+        """An animation of this result written to ``out``: see ``mbdyn.viz.animate``
+        (imported on call)."""
+        from .viz import animate
+        return animate(self, out, speed=speed, fps=fps, title=title, **options)
+
     def __repr__(self):
         return (f"<Result {self.model.name!r}: {len(self.t)} samples, t = {self.t[0]:g} .. "
                 f"{self.t[-1]:g}, events {self.events}>")
@@ -689,7 +701,8 @@ def _fixed_chunks(rhs, integrator, t0, t_end, y0, dt, compiled, events=()):
     y = y0.copy()
     t = t0
     if compiled:
-        from .kernels.integrators import SCHEMES, STAGES, fixed_step_loop
+        from .kernels.integrators import LOOPS, SCHEMES, STAGES
+        loop = LOOPS[SCHEMES[integrator]]
         args = model.loop_arguments()
         # stretches between checks of events and singularities: short when there are
         # some (a terminal event wastes at most a stretch), long otherwise
@@ -702,8 +715,7 @@ def _fixed_chunks(rhs, integrator, t0, t_end, y0, dt, compiled, events=()):
                 table = model.drive_values(stage_times).reshape(len(tk), len(STAGES), -1, 3)
                 out = np.empty((len(tk) + 1, y.size))
                 nfev = np.zeros(1, np.int64)
-                done, status = fixed_step_loop(SCHEMES[integrator], h, y, table, *args, out,
-                                               nfev)
+                done, status = loop(h, y, table, *args, out, nfev)
                 rhs.evaluations += int(nfev[0])
                 failure = None
                 if status:

@@ -12,7 +12,7 @@ from .kinematics import cross
 from .linalg3 import cross_to, mat_vec, rotate_tensor
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def applied_loads(mass, com, gravity, R, r, load_body, load_point, load_force, load_moment,
                   load_in_body, F, N):
     """Gravity and point loads reduced to each centre of mass (world components).
@@ -44,7 +44,7 @@ def applied_loads(mass, com, gravity, R, r, load_body, load_point, load_force, l
             N[i, k] += mo[k] + t[k]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def body_terms(i, com, inertia, R, w, alpha_b, a_b, c, Iw, aG_b, gyro, S3, t1, t2):
     """Per body i, into the given arrays: lever ``c`` (origin -> centre of mass), world
     inertia ``Iw``, bias acceleration of the centre of mass ``aG_b`` and the inertia
@@ -66,7 +66,7 @@ def body_terms(i, com, inertia, R, w, alpha_b, a_b, c, Iw, aG_b, gyro, S3, t1, t
         gyro[k] = t1[k] + t2[k]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def com_jacobian(i, c, JT, JR, anc_ptr, anc_idx, out):
     """Translation Jacobian of body i's centre of mass over its ancestor columns."""
     for m in range(anc_ptr[i], anc_ptr[i + 1]):
@@ -110,7 +110,7 @@ def jourdain(mass, com, inertia, has_inertia, R, r, w, alpha_b, a_b, JR, JT, anc
                       + JR[i, 0, a_] * fR[0] + JR[i, 1, a_] * fR[1] + JR[i, 2, a_] * fR[2])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc_idx, M):
     """``M`` by the composite-rigid-body algorithm, in world Pluecker coordinates.
 
@@ -197,7 +197,7 @@ def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc
 LAPACK_CHOLESKY_FROM = 40
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _lapack_cholesky(M, L, tiny):
     """``L`` from LAPACK's Cholesky; False if it fails or a pivot is below ``tiny``."""
     try:
@@ -237,7 +237,7 @@ def cholesky_solve(M, f, L, x):
     return _triangular_solves(L, f, x)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _triangular_solves(L, f, x):
     """``x`` from ``L L^T x = f`` (``L`` lower triangular); returns -1."""
     n = L.shape[0]

@@ -29,7 +29,7 @@ def kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_
                        N, force_data[0:0])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                            qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT):
     """The ``gyroscopic`` effect switched off: the motion again with every speed zero, so

@@ -27,13 +27,13 @@ SCHEMES = {"euler": EULER, "semi-implicit-euler": SEMI_IMPLICIT_EULER, "rk4": RK
 STAGES = (0.0, 0.5, 1.0)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _rates(y, nq, slots, out):
     """``q' = N(q) u`` into ``out[:nq]``."""
     coordinate_rates(y[:nq], y[nq:], slots, out[:nq])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _rhs(y, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads, ws,
          ydot, nfev):
     """``ydot = [N(q) u, M^-1 f]`` at the stage whose drive values are ``drive_vals``;
@@ -69,7 +69,7 @@ def _rhs(y, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body,
     return 0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _normalize(y, quats):
     for s in range(quats.shape[0]):
         i = quats[s]
@@ -78,73 +78,190 @@ def _normalize(y, quats):
             y[i + k] /= n
 
 
+# Each scheme's step (inlined into the loops: no compiled layer of its own) has the same
+# arguments: the step size, the state ``y`` and the slot
+# ``yn`` for the next one, the drives' stage values ``drives`` (``drive_table[n]``), the
+# model's arrays, scratch vectors ``k1 .. k4``, ``tmp`` and matrix ``J``, and the counter
+# ``nfev``.  Each returns a status code (0 done).
+
+@njit(cache=True, inline="always")
+def euler_step(h, y, yn, drives, nq, slots, free_q, free_u, drive_q, drive_u, tree, body,
+               loads, ws, k1, k2, k3, k4, tmp, J, nfev):
+    """Explicit Euler."""
+    st = _rhs(y, drives[0], nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads,
+              ws, k1, nfev)
+    if st:
+        return st
+    for i in range(y.shape[0]):
+        yn[i] = y[i] + h * k1[i]
+    return 0
+
+
+@njit(cache=True, inline="always")
+def semi_implicit_euler_step(h, y, yn, drives, nq, slots, free_q, free_u, drive_q, drive_u,
+                             tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev):
+    """Semi-implicit (symplectic) Euler: velocities first, then positions with them."""
+    ny = y.shape[0]
+    st = _rhs(y, drives[0], nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads,
+              ws, k1, nfev)
+    if st:
+        return st
+    for i in range(nq, ny):
+        yn[i] = y[i] + h * k1[i]           # velocities first
+    for i in range(nq):
+        tmp[i] = y[i]
+    for i in range(nq, ny):
+        tmp[i] = yn[i]
+    _rates(tmp, nq, slots, k2)              # positions with the new velocities
+    for i in range(nq):
+        yn[i] = y[i] + h * k2[i]
+    return 0
+
+
+@njit(cache=True, inline="always")
+def rk4_step(h, y, yn, drives, nq, slots, free_q, free_u, drive_q, drive_u, tree, body,
+             loads, ws, k1, k2, k3, k4, tmp, J, nfev):
+    """Classic fourth-order Runge-Kutta."""
+    ny = y.shape[0]
+    st = _rhs(y, drives[0], nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads,
+              ws, k1, nfev)
+    for i in range(ny):
+        tmp[i] = y[i] + 0.5 * h * k1[i]
+    st = st or _rhs(tmp, drives[1], nq, slots, free_q, free_u, drive_q, drive_u, tree, body,
+                    loads, ws, k2, nfev)
+    for i in range(ny):
+        tmp[i] = y[i] + 0.5 * h * k2[i]
+    st = st or _rhs(tmp, drives[1], nq, slots, free_q, free_u, drive_q, drive_u, tree, body,
+                    loads, ws, k3, nfev)
+    for i in range(ny):
+        tmp[i] = y[i] + h * k3[i]
+    st = st or _rhs(tmp, drives[2], nq, slots, free_q, free_u, drive_q, drive_u, tree, body,
+                    loads, ws, k4, nfev)
+    if st:
+        return st
+    for i in range(ny):
+        yn[i] = y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+    return 0
+
+
+@njit(cache=True, inline="always")
+def midpoint_step(h, y, yn, drives, nq, slots, free_q, free_u, drive_q, drive_u,
+                            tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev):
+    """Implicit midpoint (``implicit_midpoint_step`` with the common arguments)."""
+    return implicit_midpoint_step(y, h, drives[1], nq, slots, free_q, free_u, drive_q,
+                                  drive_u, tree, body, loads, ws, yn, k1, k2, tmp, J, nfev)
+
+
+@njit(cache=True, inline="always")
+def _scratch(ny):
+    """The steps' scratch space: ``k1 .. k4``, ``tmp`` and ``J``."""
+    return (np.empty(ny), np.empty(ny), np.empty(ny), np.empty(ny), np.empty(ny),
+            np.empty((ny, ny)))
+
+
+# One compiled loop per scheme, so that a run compiles only its own scheme's step (a loop
+# over all four would compile all of them: about 9 s of a first run).  The loops differ
+# only in the step they call.
+
+@njit(cache=True)
+def euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, drive_u,
+               tree, body, loads, ws, out, nfev):
+    """``fixed_step_loop`` with explicit Euler."""
+    out[0] = y0
+    k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
+    for n in range(out.shape[0] - 1):
+        st = euler_step(h, out[n], out[n + 1], drive_table[n], nq, slots, free_q, free_u,
+                        drive_q, drive_u, tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
+        if st:
+            return n, st
+        _normalize(out[n + 1], quats)
+    return out.shape[0] - 1, 0
+
+
+@njit(cache=True)
+def semi_implicit_euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q,
+                             drive_u, tree, body, loads, ws, out, nfev):
+    """``fixed_step_loop`` with semi-implicit Euler."""
+    out[0] = y0
+    k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
+    for n in range(out.shape[0] - 1):
+        st = semi_implicit_euler_step(h, out[n], out[n + 1], drive_table[n], nq, slots,
+                                      free_q, free_u, drive_q, drive_u, tree, body, loads, ws,
+                                      k1, k2, k3, k4, tmp, J, nfev)
+        if st:
+            return n, st
+        _normalize(out[n + 1], quats)
+    return out.shape[0] - 1, 0
+
+
+@njit(cache=True)
+def rk4_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, drive_u, tree,
+             body, loads, ws, out, nfev):
+    """``fixed_step_loop`` with RK4."""
+    out[0] = y0
+    k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
+    for n in range(out.shape[0] - 1):
+        st = rk4_step(h, out[n], out[n + 1], drive_table[n], nq, slots, free_q, free_u,
+                      drive_q, drive_u, tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
+        if st:
+            return n, st
+        _normalize(out[n + 1], quats)
+    return out.shape[0] - 1, 0
+
+
+@njit(cache=True)
+def implicit_midpoint_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q,
+                           drive_u, tree, body, loads, ws, out, nfev):
+    """``fixed_step_loop`` with the implicit midpoint rule."""
+    out[0] = y0
+    k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
+    for n in range(out.shape[0] - 1):
+        st = midpoint_step(h, out[n], out[n + 1], drive_table[n], nq, slots,
+                                     free_q, free_u, drive_q, drive_u, tree, body, loads, ws,
+                                     k1, k2, k3, k4, tmp, J, nfev)
+        if st:
+            return n, st
+        _normalize(out[n + 1], quats)
+    return out.shape[0] - 1, 0
+
+
+#: the compiled loop of each scheme code
+LOOPS = {EULER: euler_loop, SEMI_IMPLICIT_EULER: semi_implicit_euler_loop, RK4: rk4_loop,
+         IMPLICIT_MIDPOINT: implicit_midpoint_loop}
+
+
 @njit(cache=True)
 def fixed_step_loop(scheme, h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q,
                     drive_u, tree, body, loads, ws, out, nfev):
     """Run ``out.shape[0] - 1`` steps of size ``h`` from ``y0``; ``out[k]`` is the state
     after k steps.  ``drive_table[k, s]`` holds the drives' ``(q, q', q'')`` at stage time
     ``t_k + STAGES[s] h``; ``nfev[0]`` counts right-hand-side evaluations.
-    Returns ``(steps done, status)``."""
-    ny = y0.shape[0]
-    n_steps = out.shape[0] - 1
+    Returns ``(steps done, status)``.
+
+    The scheme is chosen at run time (for ``kernels.batched``), so this compiles all four
+    steps; a single run calls its scheme's loop in ``LOOPS``, which does the same steps."""
     out[0] = y0
-    k1 = np.empty(ny)
-    k2 = np.empty(ny)
-    k3 = np.empty(ny)
-    k4 = np.empty(ny)
-    tmp = np.empty(ny)
-    J = np.empty((ny, ny))
-    for n in range(n_steps):
-        y = out[n]
-        yn = out[n + 1]
+    k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
+    for n in range(out.shape[0] - 1):
+        y, yn, drives = out[n], out[n + 1], drive_table[n]
         if scheme == EULER:
-            st = _rhs(y, drive_table[n, 0], nq, slots, free_q, free_u, drive_q, drive_u, tree,
-                      body, loads, ws, k1, nfev)
-            if st:
-                return n, st
-            for i in range(ny):
-                yn[i] = y[i] + h * k1[i]
+            st = euler_step(h, y, yn, drives, nq, slots, free_q, free_u, drive_q, drive_u,
+                            tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
         elif scheme == SEMI_IMPLICIT_EULER:
-            st = _rhs(y, drive_table[n, 0], nq, slots, free_q, free_u, drive_q, drive_u, tree,
-                      body, loads, ws, k1, nfev)
-            if st:
-                return n, st
-            for i in range(nq, ny):
-                yn[i] = y[i] + h * k1[i]           # velocities first
-            for i in range(nq):
-                tmp[i] = y[i]
-            for i in range(nq, ny):
-                tmp[i] = yn[i]
-            _rates(tmp, nq, slots, k2)              # positions with the new velocities
-            for i in range(nq):
-                yn[i] = y[i] + h * k2[i]
+            st = semi_implicit_euler_step(h, y, yn, drives, nq, slots, free_q, free_u,
+                                          drive_q, drive_u, tree, body, loads, ws, k1, k2, k3,
+                                          k4, tmp, J, nfev)
         elif scheme == RK4:
-            st = _rhs(y, drive_table[n, 0], nq, slots, free_q, free_u, drive_q, drive_u, tree,
-                      body, loads, ws, k1, nfev)
-            for i in range(ny):
-                tmp[i] = y[i] + 0.5 * h * k1[i]
-            st = st or _rhs(tmp, drive_table[n, 1], nq, slots, free_q, free_u, drive_q,
-                            drive_u, tree, body, loads, ws, k2, nfev)
-            for i in range(ny):
-                tmp[i] = y[i] + 0.5 * h * k2[i]
-            st = st or _rhs(tmp, drive_table[n, 1], nq, slots, free_q, free_u, drive_q,
-                            drive_u, tree, body, loads, ws, k3, nfev)
-            for i in range(ny):
-                tmp[i] = y[i] + h * k3[i]
-            st = st or _rhs(tmp, drive_table[n, 2], nq, slots, free_q, free_u, drive_q,
-                            drive_u, tree, body, loads, ws, k4, nfev)
-            if st:
-                return n, st
-            for i in range(ny):
-                yn[i] = y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            st = rk4_step(h, y, yn, drives, nq, slots, free_q, free_u, drive_q, drive_u, tree,
+                          body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
         else:
-            st = implicit_midpoint_step(y, h, drive_table[n, 1], nq, slots, free_q, free_u,
-                                        drive_q, drive_u, tree, body, loads, ws, yn, k1, k2,
-                                        tmp, J, nfev)
-            if st:
-                return n, st
+            st = midpoint_step(h, y, yn, drives, nq, slots, free_q, free_u, drive_q,
+                                         drive_u, tree, body, loads, ws, k1, k2, k3, k4, tmp, J,
+                                         nfev)
+        if st:
+            return n, st
         _normalize(yn, quats)
-    return n_steps, 0
+    return out.shape[0] - 1, 0
 
 
 @njit(cache=True)

@@ -1,0 +1,105 @@
+"""First start: the cost of ``import mbdyn`` and of a cold and a warm ``mbdyn run``.
+
+    python benchmarks/first_start.py [--warm 3] [--cold 1] [--source DIR]
+
+Copies the package (``mbdyn/`` of ``--source``, default this checkout) and the model into a
+temporary directory, so that the cold runs start from an empty numba cache without
+touching the checkout's own cache, and times, as separate processes:
+
+* ``python -c "import mbdyn"`` (and ``python -c pass`` for reference);
+* the cold ``python -m mbdyn run models/top.toml --case a``: every ``__pycache__`` of the
+  copy deleted first, so every kernel the run needs is compiled;
+* the warm run: the same command again, the kernels loaded from the cache.
+
+Prints a markdown table of the medians (wall time and CPU time: user + system of the
+child) over the runs.  The machine's load shows in the wall times; compare CPU times, and
+compare against a baseline measured in the same session (``--source`` of another
+checkout, e.g. a ``git worktree`` of an older commit).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import resource
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+COMMAND = ["-m", "mbdyn", "run", "models/top.toml", "--case", "a"]
+
+
+def timed(args, cwd):
+    """Run ``python ARGS`` in ``cwd``; returns ``(wall s, cpu s)`` of the child."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    start = time.perf_counter()
+    subprocess.run([sys.executable, *args], cwd=cwd, check=True, stdout=subprocess.DEVNULL,
+                   stderr=subprocess.DEVNULL, env={**os.environ, "PYTHONPATH": cwd})
+    wall = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, cpu
+
+
+def clear_cache(root):
+    """Delete every ``__pycache__`` under ``root/mbdyn`` (numba caches its kernels there)."""
+    for dirpath, dirnames, _ in os.walk(os.path.join(root, "mbdyn")):
+        if "__pycache__" in dirnames:
+            shutil.rmtree(os.path.join(dirpath, "__pycache__"))
+            dirnames.remove("__pycache__")
+
+
+def median(rows):
+    return statistics.median(r[0] for r in rows), statistics.median(r[1] for r in rows)
+
+
+def measure(source, n_warm, n_cold, n_import):
+    """``{label: (n, wall, cpu)}`` for a copy of ``source``'s package."""
+    with tempfile.TemporaryDirectory(prefix="mbdyn-first-start-") as tmp:
+        shutil.copytree(os.path.join(source, "mbdyn"), os.path.join(tmp, "mbdyn"),
+                        ignore=shutil.ignore_patterns("__pycache__"))
+        os.makedirs(os.path.join(tmp, "models"))
+        shutil.copy(os.path.join(source, "models", "top.toml"), os.path.join(tmp, "models"))
+        out = {}
+        cold = []
+        for _ in range(n_cold):
+            clear_cache(tmp)
+            cold.append(timed(COMMAND, tmp))
+        if not n_cold:                   # the warm runs need a filled cache
+            clear_cache(tmp)
+            timed(COMMAND, tmp)
+        warm = [timed(COMMAND, tmp) for _ in range(n_warm)]
+        python = [timed(["-c", "pass"], tmp) for _ in range(n_import)]
+        imports = [timed(["-c", "import mbdyn"], tmp) for _ in range(n_import)]
+        out["python -c pass (reference)"] = (n_import, *median(python))
+        out["python -c 'import mbdyn'"] = (n_import, *median(imports))
+        if cold:
+            out["cold `mbdyn run models/top.toml --case a`"] = (n_cold, *median(cold))
+        out["warm `mbdyn run models/top.toml --case a`"] = (n_warm, *median(warm))
+        return out
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--warm", type=int, default=3, help="warm runs (default 3)")
+    parser.add_argument("--cold", type=int, default=1, help="cold runs (default 1)")
+    parser.add_argument("--imports", type=int, default=5,
+                        help="runs of python -c 'import mbdyn' (default 5)")
+    parser.add_argument("--source", default=HERE,
+                        help="checkout whose mbdyn/ and models/top.toml to measure "
+                             "(default this one)")
+    args = parser.parse_args(argv)
+    rows = measure(os.path.abspath(args.source), args.warm, args.cold, args.imports)
+    print(f"{os.cpu_count()} cores, Python {sys.version.split()[0]}, "
+          f"source {os.path.abspath(args.source)}\n")
+    print("| what | runs | wall (median, s) | CPU (median, s) |")
+    print("|---|---:|---:|---:|")
+    for label, (n, wall, cpu) in rows.items():
+        print(f"| {label} | {n} | {wall:.2f} | {cpu:.2f} |")
+
+
+if __name__ == "__main__":
+    main()
