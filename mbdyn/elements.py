@@ -6,6 +6,7 @@ error raised here names the element and says what to change.
 from __future__ import annotations
 
 import math
+import re
 import warnings
 from dataclasses import dataclass, field
 from typing import Callable
@@ -177,6 +178,10 @@ def make_shape(shape, element, parameters=None):
     if missing:
         raise ModelError(f"{element}: a {kind} shape needs {', '.join(missing)}")
     out = {"type": kind, "color": str(shape.get("color", "") or "")}
+    if out["color"] and not re.fullmatch(r"#[0-9a-fA-F]{6}|#[0-9a-fA-F]{3}|[A-Za-z]{3,20}",
+                                         out["color"]):
+        raise ModelError(f"{element}: shape color {out['color']!r} is neither \"#rrggbb\" "
+                         "nor a colour name such as \"steelblue\"")
     p = parameters or {}
     for key in ("radius", "length"):
         if key in shape:

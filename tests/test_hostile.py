@@ -174,6 +174,11 @@ FILE_CASES = [
      RUN, 0, r"simulation.rtol ignored"),
     ("output-dt-not-multiple", model_text() + 'integrator = "rk4"\ndt = 0.01\n'
      'output_dt = 0.015\n', RUN, 0, r"not a multiple of dt"),
+    ("shape-color", BASE.replace('com = ["l", 0, 0]', 'com = ["l", 0, 0]\nshape = { type = '
+                                 '"sphere", radius = 0.05, color = "#zzzzzz" }'), RUN, 1,
+     r"bodies\[0\].*shape color"),
+    ("sweep-out-extension", BASE, ["sweep", "{model}", "--grid", "parameters.l=1:2:2", "--out",
+                                   "{tmp}/s.xlsx"], 1, r"--out .*\.csv"),
     ("t-end-flag-huge", BASE, RUN + ["--t-end", "1e300"], 1, r"--t-end 1e300.*range"),
     ("t-end-flag-nan", BASE, RUN + ["--t-end", "nan"], 1, r"--t-end nan.*not a finite"),
     ("max-steps-fraction", BASE, RUN + ["--max-steps", "1.5"], 1, r"whole number"),

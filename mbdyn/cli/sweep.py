@@ -71,6 +71,9 @@ def _json_value(v):
 def run(args):
     if args.resume and not args.out:
         raise ModelError("--resume needs --out FILE (the table to complete)")
+    if args.out and not args.out.endswith((".csv", ".parquet")):
+        raise ModelError(f"--out {args.out}: the table is written as .csv (or .parquet); "
+                         "name the file so")
     if not args.grid:
         raise ModelError("give at least one --grid PATH=VALUES (e.g. "
                          "--grid parameters.Mz=-0.03:-0.001:8)")
