@@ -43,6 +43,20 @@ MAX_RANGE_POINTS = 100_000
 #: members of one sweep (the product of its axes, times its cases)
 MAX_SWEEP_MEMBERS = 1_000_000
 
+
+
+def magnitude_problem(value):
+    """Why a number a model gives is outside ``MIN_MAGNITUDE .. MAX_MAGNITUDE`` (``None``
+    if it is inside, or zero)."""
+    if value != 0 and abs(value) < MIN_MAGNITUDE:
+        return (f"{value:g} is below the range mbdyn accepts (0 or |x| >= {MIN_MAGNITUDE:g}; "
+                "its square underflows); check the units, or write 0")
+    if abs(value) > MAX_MAGNITUDE:
+        return (f"{value:g} is beyond the range mbdyn accepts (|x| <= {MAX_MAGNITUDE:g}; "
+                "products of such numbers overflow); check the units")
+    return None
+
+
 # -- work (defaults a user can raise)
 #: stored samples of one run (rows of t, q, u); beyond it give output_dt to decimate
 MAX_SAMPLES = 2_000_000

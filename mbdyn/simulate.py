@@ -418,7 +418,7 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     pre_stats = {}
     _conditioning(model, q, t0, pre_stats, "mass_matrix_condition_initial")
     if integrator not in ADAPTIVE:
-        dt = _check_fixed_step(integrator, dt, t0, t_end, t_eval, budget)
+        dt = _check_fixed_step(integrator, dt, t0, t_end, t_eval, budget, 1 + y0.size)
     elif dt is not None:
         warnings.warn(f"dt = {dt!r} is ignored: the adaptive integrator {integrator} chooses "
                       "its own steps (bound them with max_step, or choose a fixed-step "
@@ -482,7 +482,7 @@ def _budget(max_steps, max_samples, max_wall_time, decimate):
     return out
 
 
-def _check_fixed_step(integrator, dt, t0, t_end, t_eval, budget):
+def _check_fixed_step(integrator, dt, t0, t_end, t_eval, budget, width):
     """``dt`` as a float, after refusing what a fixed-step run cannot do: no or a bad
     ``dt``, more steps than ``max_steps``, more stored samples than ``max_samples`` (both
     known before the run starts)."""
@@ -502,7 +502,7 @@ def _check_fixed_step(integrator, dt, t0, t_end, t_eval, budget):
     stored = len(t_eval) if t_eval is not None else steps / budget["decimate"] + 1
     if stored > budget["max_samples"]:
         raise ModelError(f"the run would store {stored:.3g} samples (about "
-                         f"{stored * 8 * 12 / 1e9:.2g} GB for a small model), more than "
+                         f"{stored * 8 * width / 1e9:.2g} GB of t, q and u), more than "
                          f"max_samples = {budget['max_samples']}; keep fewer (output_dt in a "
                          "model file, decimate or t_eval in Python) or raise max_samples "
                          "(--max-samples)")

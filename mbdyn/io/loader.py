@@ -351,14 +351,9 @@ class _SceneBuilder:
         return e if e.free_symbols else v
 
     def bounded(self, v, path):
-        if v != 0 and abs(v) < limits.MIN_MAGNITUDE:
-            raise self.error(path, f"{v:g} is below the range mbdyn accepts (0 or |x| >= "
-                             f"{limits.MIN_MAGNITUDE:g}; its square underflows); check the "
-                             "units, or write 0")
-        if abs(v) > limits.MAX_MAGNITUDE:
-            raise self.error(path, f"{v:g} is beyond the range mbdyn accepts (|x| <= "
-                             f"{limits.MAX_MAGNITUDE:g}; products of such numbers overflow); "
-                             "check the units")
+        problem = limits.magnitude_problem(v)
+        if problem:
+            raise self.error(path, problem)
 
     def pvector(self, value, path, default=(0.0, 0.0, 0.0)):
         if value is None:

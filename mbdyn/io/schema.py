@@ -176,14 +176,9 @@ def scan_document(doc, file):
 
 
 def _check_magnitude(file, where, value):
-    if value != 0 and abs(value) < limits.MIN_MAGNITUDE:
-        raise ModelFileError(file, where, f"{value:g} is below the range mbdyn accepts "
-                             f"(0 or |x| >= {limits.MIN_MAGNITUDE:g}; its square underflows); "
-                             "check the units, or write 0")
-    if abs(value) > limits.MAX_MAGNITUDE:
-        raise ModelFileError(file, where, f"{value:g} is beyond the range mbdyn accepts "
-                             f"(|x| <= {limits.MAX_MAGNITUDE:g}; products of such numbers "
-                             "overflow); check the units")
+    problem = limits.magnitude_problem(value)
+    if problem:
+        raise ModelFileError(file, where, problem)
 
 
 # ---------------------------------------------------------------------------- checking

@@ -216,9 +216,9 @@ def implicit_midpoint_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u,
     out[0] = y0
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
     for n in range(out.shape[0] - 1):
-        st = midpoint_step(h, out[n], out[n + 1], drive_table[n], nq, slots,
-                                     free_q, free_u, drive_q, drive_u, tree, body, loads, ws,
-                                     k1, k2, k3, k4, tmp, J, nfev)
+        st = midpoint_step(h, out[n], out[n + 1], drive_table[n], nq, slots, free_q, free_u,
+                           drive_q, drive_u, tree, body, loads, ws, k1, k2, k3, k4, tmp, J,
+                           nfev)
         if st:
             return n, st
         _normalize(out[n + 1], quats)
