@@ -26,7 +26,14 @@ from .kernels import joints as kj
 from .kernels import packed as kp
 from .kernels.kinematics import point_jacobian
 
-METHODS = ("jourdain", "newton-euler")
+#: formulations of the forward dynamics: ``M(q) u' = f`` (Jourdain, composite-rigid-body
+#: mass matrix and Cholesky), the articulated-body algorithm (O(n)), the Newton-Euler
+#: system with reaction unknowns eliminated in tree order (O(n)) and the same system as the
+#: textbook writes it, assembled dense and solved by LU
+METHODS = ("jourdain", "articulated", "newton-euler", "newton-euler-dense")
+#: "auto" takes the articulated-body route from this many free speeds on (below it the
+#: mass matrix and its Cholesky factor are cheaper; benchmarks/forward_dynamics.py)
+ARTICULATED_FROM = 8
 
 
 def _perpendicular_pair(a):
@@ -184,6 +191,11 @@ class Model:
             cols.append(sorted(inherited + own))
         self._anc_ptr = np.cumsum([0] + [len(c) for c in cols]).astype(np.int64)
         self._anc_idx = np.array([c for cs in cols for c in cs], np.int64)
+        # and each frame's own columns only (the articulated-body route reads no others)
+        own = [list(range(ucol[i], ucol[i] + j.nu)) if ucol[i] >= 0 else []
+               for i, j in enumerate(joints)]
+        self._own_ptr = np.cumsum([0] + [len(c) for c in own]).astype(np.int64)
+        self._own_idx = np.array([c for cs in own for c in cs], np.int64)
         # -- body arrays
         self._mass = np.array([b.mass for b in bodies], float)
         self._com = np.array([b.com for b in bodies], float).reshape(n, 3)
@@ -248,6 +260,12 @@ class Model:
         self._A = np.zeros((6 * n, 6 * n))
         self._b = np.zeros(6 * n)
         self._ud = np.zeros(self.nu)
+        # articulated bodies (kernels.articulated): per frame 6x6 inertias, biases, the
+        # joint's U = IA S and Cholesky factor of D, accelerations, joint wrenches
+        self._IA, self._U = np.zeros((n, 6, 6)), np.zeros((n, 6, 6))
+        self._pA, self._cb, self._acc = np.zeros((n, 6)), np.zeros((n, 6)), np.zeros((n, 6))
+        self._Dl, self._W = np.zeros((n, 6, 7)), np.zeros((n, 6))
+        self._lam = np.zeros(len(rj))
         self._slots = np.array(self._free_joint_slots, np.int64).reshape(-1, 5)
         self._pack()
         #: (load name, the row of the load array its function fills, the function)
@@ -622,21 +640,44 @@ class Model:
         return self._f.copy()
 
     def forward_dynamics(self, q, u, t=0.0, method="jourdain"):
-        """Speed rates ``u'`` from ``M(q) u' = f(q, u, t)`` (``method="jourdain"``) or from
-        the Newton-Euler system with reactions (``method="newton-euler"``)."""
-        if method == "jourdain":
+        """Speed rates ``u'``: from ``M(q) u' = f(q, u, t)`` (``method="jourdain"``), by the
+        articulated-body algorithm (``"articulated"``), or from the Newton-Euler system with
+        reactions, eliminated in tree order (``"newton-euler"``) or assembled dense and
+        solved by LU (``"newton-euler-dense"``).  All four solve the same equations;
+        ``docs/performance.md`` says which is fastest at which size."""
+        if method in ("jourdain", "articulated"):
             q, u = self._state(q, u)
             if self._python_inputs:
                 self._fill_inputs(q, u, t)
-            pivot = kp.jourdain_accelerations_packed(*self._packed, q, u)
+            kernel = (kp.jourdain_accelerations_packed if method == "jourdain"
+                      else kp.articulated_accelerations_packed)
+            pivot = kernel(*self._packed, q, u)
             if pivot >= 0:
                 self._raise_singular(q, t, pivot)
             if pivot == -2:
                 self._check_finite(q, u, t, self._ud, "the accelerations")
             return self._ud.copy()
-        if method == "newton-euler":
-            return self._newton_euler(q, u, t)[:self.nu].copy()
+        if method in ("newton-euler", "newton-euler-dense"):
+            return self._newton_euler(q, u, t, dense=method == "newton-euler-dense")[:self.nu]
         raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")
+
+    def formulation(self, method="auto"):
+        """The per-call route ``method`` stands for: ``"auto"`` is ``"jourdain"`` for fewer
+        than ``ARTICULATED_FROM`` free speeds, else ``"articulated"`` (measured crossover,
+        docs/performance.md); any other name is checked and returned."""
+        if method == "auto":
+            return "jourdain" if self.nu < ARTICULATED_FROM else "articulated"
+        if method not in METHODS:
+            raise ModelError(f"unknown method {method!r}; use 'auto' or one of "
+                             f"{', '.join(METHODS)}")
+        return method
+
+    def lowlevel(self, method="auto"):
+        """The low-level entry (``mbdyn.lowlevel.LowLevel``): ``forward_dynamics(q, u)``
+        and ``state_derivative(y)`` as single compiled calls on preallocated buffers, for
+        loops of your own; ``method``: ``"auto"``, ``"jourdain"`` or ``"articulated"``."""
+        from .lowlevel import LowLevel
+        return LowLevel(self, self.formulation(method))
 
     def _check_at_rest(self, q, t=0.0):
         """Raise what ``forward_dynamics(q, 0, t)`` raises -- ``SingularMassMatrixError``
@@ -651,18 +692,25 @@ class Model:
             self._raise_singular(q, t, pivot)
         self._check_finite(q, u, t, self._ud, "the accelerations")
 
-    def state_derivative(self, t, y):
-        """``[q', u']`` for the state ``y = [q, u]`` by the Jourdain formulation, in one
-        compiled call: ``q' = N(q) u`` (``coordinate_rates``) and ``u'`` from
-        ``forward_dynamics``.  Returns a new array."""
+    def state_derivative(self, t, y, method="jourdain"):
+        """``[q', u']`` for the state ``y = [q, u]`` in one compiled call: ``q' = N(q) u``
+        (``coordinate_rates``) and ``u'`` as ``forward_dynamics`` gives it (``method``:
+        ``"jourdain"`` or ``"articulated"``).  Returns a new array."""
         y = np.asarray(y, dtype=float)
         if y.shape != (self.nq + self.nu,):
             raise ModelError(f"model {self.name!r} expects a state of length "
                              f"{self.nq + self.nu} (q then u), got shape {y.shape}")
+        if method == "jourdain":
+            kernel = kp.state_derivative_packed
+        elif method == "articulated":
+            kernel = kp.state_derivative_articulated_packed
+        else:
+            raise ModelError(f"state_derivative: unknown method {method!r}; use 'jourdain' "
+                             "or 'articulated'")
         if self._python_inputs:
             self._fill_inputs(y[:self.nq], y[self.nq:], t)
         ydot = np.empty(self.nq + self.nu)
-        status = kp.state_derivative_packed(*self._packed, y, ydot)
+        status = kernel(*self._packed, y, ydot)
         if status >= 0:
             self._raise_singular(y[:self.nq], t, status)
         if status == -2:
@@ -671,25 +719,25 @@ class Model:
                                rates)
         return ydot
 
-    def _newton_euler(self, q, u, t, packed=True):
-        """The Newton-Euler unknowns ``[u', reactions]`` and whether all are finite.
-        ``packed``: one call on the packed buffers (cheapest per call, for right-hand
-        sides); else the same kernel on the arrays (``newton_euler``, ``reactions``: a
-        run that only evaluates reactions at its output points compiles less)."""
+    def _newton_euler(self, q, u, t, dense=False):
+        """The Newton-Euler unknowns ``[u', reactions]`` (a new array): eliminated in tree
+        order (``kernels.articulated``), or, with ``dense``, the system of
+        ``kernels.dynamics.newton_euler_system`` solved by LU."""
         q, u = self._state(q, u)
+        if not dense:
+            if self._python_inputs:
+                self._fill_inputs(q, u, t)
+            status = kp.newton_euler_tree_packed(*self._packed, q, u)
+            if status >= 0:
+                self._raise_singular(q, t, status)
+            x = np.concatenate([self._ud, self._lam])
+            if status == -2:
+                self._check_finite(q, u, t, x, "the Newton-Euler solution")
+            return x
         try:
-            if packed:
-                if self._python_inputs:
-                    self._fill_inputs(q, u, t)
-                x, finite = kp.newton_euler_solution_packed(*self._packed, q, u)
-            else:
-                self._fill(q, u, t)
-                x = ke.newton_euler_solution(
-                    *self._tree, self._mass, self._com, self._inertia, self.gravity,
-                    self._qfull, self._ufull, self._udfull, *self._loads_arrays,
-                    self._react_joint, self._react_force, self._react_moment,
-                    *self._kin_out, self._A, self._b)
-                finite = bool(np.all(np.isfinite(x)))
+            if self._python_inputs:
+                self._fill_inputs(q, u, t)
+            x, finite = kp.newton_euler_solution_packed(*self._packed, q, u)
         except np.linalg.LinAlgError:     # singular, or fed NaN/Inf: tell which
             self._jourdain_terms(q, u, t)
             for out in (self._f, np.diag(self._M)):
@@ -701,6 +749,7 @@ class Model:
         return x
 
     def _raise_singular(self, q, t, pivot):
+        self._jourdain_terms(q, np.zeros(self.nu), t)   # M at q (whatever route failed)
         M = self._M
         if not np.all(np.isfinite(M)):   # a NaN pivot: the input, not the inertia
             self._require_finite(q, self._ufull[self._free_u] if self._driven else
@@ -724,12 +773,14 @@ class Model:
             "sin(theta)=0, use a spherical (quaternion) joint.".format(eigval[0], eigval[-1]),
             names)
 
-    def newton_euler(self, q, u, t=0.0):
-        """Solve the Newton-Euler equations with reaction unknowns.
+    def newton_euler(self, q, u, t=0.0, dense=False):
+        """Solve the Newton-Euler equations with reaction unknowns, eliminated in tree
+        order (O(n)) or, with ``dense=True``, assembled as one 6n system and solved by LU
+        (the textbook's literal form).
 
         Returns ``(ud, reactions)``; ``reactions`` as in ``Model.reactions``.
         """
-        x = self._newton_euler(q, u, t, packed=False)
+        x = self._newton_euler(q, u, t, dense=dense)
         return x[:self.nu].copy(), self._reactions_from(x[self.nu:])
 
     def _reactions_from(self, lam):
@@ -748,16 +799,17 @@ class Model:
         (``frame="world"``) or in the child frame's own components (``frame="child"``, as
         the textbook writes reactions).
 
-        ``method="newton-euler"`` solves the system with reaction unknowns;
-        ``"jourdain"`` computes the accelerations from ``M u' = f`` and then the joint
+        ``method="newton-euler"`` solves the system with reaction unknowns in tree order
+        (``"newton-euler-dense"``: the dense 6n system); ``"jourdain"`` and
+        ``"articulated"`` compute the accelerations by that route and then the joint
         wrenches by inverse dynamics from the leaves to the root.
         """
         if frame not in ("world", "child"):
             raise ModelError(f"unknown frame {frame!r} for reactions; use 'world' or 'child'")
-        if method == "newton-euler":
-            out = self.newton_euler(q, u, t)[1]
-        elif method == "jourdain":
-            ud = self.forward_dynamics(q, u, t)
+        if method in ("newton-euler", "newton-euler-dense"):
+            out = self.newton_euler(q, u, t, dense=method == "newton-euler-dense")[1]
+        elif method in ("jourdain", "articulated"):
+            ud = self.forward_dynamics(q, u, t, method=method)
             self._kinematics_kernel(q, u, t, ud)
             self._drop_velocity_products()
             w = np.empty((self.n_frames, 6))
@@ -927,19 +979,28 @@ class Model:
                 out[k, d] = drive.position(tk), drive.velocity(tk), drive.acceleration(tk)
         return out
 
-    def loop_arguments(self):
+    def loop_arguments(self, method="jourdain"):
         """The arrays ``kernels.integrators.fixed_step_loop`` needs after its drive table:
-        ``(nq, slots, quats, free_q, free_u, drive_q, drive_u, tree, body, loads, ws)``."""
+        ``(nq, slots, quats, free_q, free_u, drive_q, drive_u, tree, body, loads, ws)``;
+        laid out for ``method`` ``"jourdain"`` or ``"articulated"`` (the compiled loops
+        choose their route by the workspace's layout, ``integrators.accelerations``)."""
         slots = self._slots
         quats = np.array([s.start for s in self._quaternions], np.int64)
         drive_q = np.array([d[1] for d in self._driven], np.int64)
         drive_u = np.array([d[2] for d in self._driven], np.int64)
         body = (self._mass, self._com, self._inertia, self._has_inertia, self.gravity)
         ws = (self._qfull, self._ufull, self._udfull, self._R, self._r, self._w, self._v,
-              self._alpha, self._a, self._JR, self._JT, self._F, self._N, self._M, self._f,
-              self._L)
+              self._alpha, self._a, self._JR, self._JT, self._F, self._N)
+        tree = self._tree
+        if method == "jourdain":
+            ws += (self._M, self._f, self._L)
+        elif method == "articulated":
+            ws += (self._IA, self._pA, self._cb, self._U, self._Dl, self._acc)
+            tree = tree[:9] + (self._own_ptr, self._own_idx)
+        else:
+            raise ModelError(f"loop_arguments: no compiled loop for method {method!r}")
         return (self.nq, slots, quats, self._free_q, self._free_u, drive_q, drive_u,
-                self._tree, body, self._loads_arrays, ws)
+                tree, body, self._loads_arrays, ws)
 
     def describe_speeds(self, speeds):
         """``"theta2 (joint 'theta2')"``: the coordinates and joints behind some speeds

@@ -20,6 +20,7 @@ from .balance import energy_balance
 from .events import Event, EventRecord, as_event, check_conditions
 from .force_packing import warn_outside_tables
 from . import limits
+from .compile import METHODS as _METHODS
 from .errors import (ModelError, ModelWarning, NonFiniteError, SimulationError,
                      SingularityWarning, SingularMassMatrixError)
 
@@ -294,8 +295,8 @@ class _RightHandSide:
         self.evaluations += 1
         if self.symbolic is not None:
             return self.symbolic(t, y)  # a new array every call
-        if self.method == "jourdain":
-            return self.model.state_derivative(t, y)   # a new array every call
+        if self.method in ("jourdain", "articulated"):
+            return self.model.state_derivative(t, y, self.method)   # a new array every call
         q = y[:self.nq]
         u = y[self.nq:]
         out = np.empty_like(y)      # a fresh array: scipy's solvers keep what they are given
@@ -306,7 +307,7 @@ class _RightHandSide:
 
 #: The defaults of every run -- Python, model files and the command line: DOP853 at
 #: rtol 1e-9, atol 1e-12 (docs/accuracy.md says why).
-DEFAULTS = {"integrator": "DOP853", "rtol": 1e-9, "atol": 1e-12, "method": "jourdain"}
+DEFAULTS = {"integrator": "DOP853", "rtol": 1e-9, "atol": 1e-12, "method": "auto"}
 
 
 def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["integrator"],
@@ -323,8 +324,10 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     for its rate, as in model files.  ``integrator``: one of ``INTEGRATORS`` (default
     ``DEFAULTS``: DOP853 at rtol 1e-9, atol 1e-12, the same as model files and the command
     line); the fixed-step ones need ``dt``.
-    ``method``: ``"jourdain"``, ``"newton-euler"`` or ``"symbolic"`` (the closed-form
-    equations compiled by ``mbdyn.symbolic.compiled_rhs``).  ``events``: ``Event``s.
+    ``method``: ``"auto"`` (the default: ``"jourdain"`` for small models, the O(n)
+    ``"articulated"`` route for large ones, ``Model.formulation``), ``"jourdain"``,
+    ``"articulated"``, ``"newton-euler"``, ``"newton-euler-dense"`` or ``"symbolic"`` (the
+    closed-form equations compiled by ``mbdyn.symbolic.compiled_rhs``).  ``events``: ``Event``s.
     ``t_eval``: output times (default every accepted step).  ``outputs``: any of ``"reactions"``,
     ``"energy"``; ``points``: ``{name: (frame, offset)}``; ``reactions_frame``:
     ``"world"`` or ``"child"`` (the child frame's components, as the textbook writes
@@ -352,9 +355,11 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
         model = model.compile()           # a System: compile it here
     if integrator not in INTEGRATORS:
         raise ModelError(f"unknown integrator {integrator!r}; use one of {', '.join(INTEGRATORS)}")
-    if method not in ("jourdain", "newton-euler", "symbolic"):
-        raise ModelError(f"unknown method {method!r}; use 'jourdain', 'newton-euler' or "
-                         "'symbolic'")
+    if method not in ("auto",) + _METHODS + ("symbolic",):
+        raise ModelError(f"unknown method {method!r}; use one of "
+                         f"{', '.join(('auto',) + _METHODS + ('symbolic',))}")
+    if method != "symbolic":
+        method = model.formulation(method)   # "auto": by the model's size
     try:
         t0, t_end = float(t0), float(t_end)
     except (TypeError, ValueError):
@@ -434,7 +439,8 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
                                             max_step, events, t_eval, progress, monitor,
                                             budget)
     else:
-        compiled = compiled_loop and method == "jourdain" and not model.has_callable_loads
+        compiled = (compiled_loop and method in ("jourdain", "articulated")
+                    and not model.has_callable_loads)
         ts, ys, found, info = _run_fixed(rhs, integrator, t0, t_end, y0, float(dt), events,
                                          t_eval, progress, monitor, compiled, budget)
     wall = _time.perf_counter() - start
@@ -703,7 +709,7 @@ def _fixed_chunks(rhs, integrator, t0, t_end, y0, dt, compiled, events=()):
     if compiled:
         from .kernels.integrators import LOOPS, SCHEMES, STAGES
         loop = LOOPS[SCHEMES[integrator]]
-        args = model.loop_arguments()
+        args = model.loop_arguments(rhs.method)
         # stretches between checks of events and singularities: short when there are
         # some (a terminal event wastes at most a stretch), long otherwise
         chunk = 200 if (events or model._euler_middle) else 2000

@@ -298,8 +298,9 @@ def batchable(scene, quantities):
     model = scene.model
     if s["integrator"] not in FIXED_STEP:
         return f"integrator {s['integrator']!r} is adaptive; batched runs are fixed-step"
-    if s["method"] != "jourdain":
-        return "batched runs use method 'jourdain'"
+    if s["method"] == "symbolic" or model.formulation(s["method"]) != "jourdain":
+        return ("batched runs use M u' = f (method 'jourdain'); this run's method is "
+                f"{s['method']!r}")
     if scene.events:
         return "the model has events (checked per step in Python)"
     if model._euler_middle:

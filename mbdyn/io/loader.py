@@ -38,7 +38,7 @@ from .schema import (DIRECTIONS, Checker, _suggest, apply_case, apply_override,
 
 #: The formulations a run can use -- the one list behind ``[simulation] method`` and
 #: ``mbdyn run --method``.  Extend it here when a formulation is added.
-METHODS = tuple(_compile.METHODS) + ("symbolic",)
+METHODS = ("auto",) + tuple(_compile.METHODS) + ("symbolic",)
 
 #: ``[simulation]`` defaults.
 DEFAULT_SIMULATION = dict(SIMULATE_DEFAULTS)     # one set of defaults (mbdyn.simulate)

@@ -115,8 +115,9 @@ def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc
     """``M`` by the composite-rigid-body algorithm, in world Pluecker coordinates.
 
     A speed's column is a twist ``S = (w, v0)``: angular velocity and the velocity of the
-    material point at the world origin.  Each body's spatial inertia about the world
-    origin is ``[[I_G - m [c]x[c]x, m [c]x], [-m [c]x, m E]]``; summed over subtrees into
+    material point at a reference point ``o`` (the first frame's origin: about the world
+    origin, a model far from it would lose digits to ``m |r|^2``).  Each body's spatial
+    inertia about ``o`` is ``[[I_G - m [c]x[c]x, m [c]x], [-m [c]x, m E]]``; summed over subtrees into
     composite inertias ``IC``, they give ``M[a, b] = S_a . IC_k S_b`` for every column b of
     frame k's joint and every column a of k's joint or an ancestor's -- O(n d^2) instead of
     the O(n nu^2) of summing ``J^T m J`` body by body.
@@ -130,6 +131,9 @@ def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc
     tmp = np.empty(9)                   # the vector temporaries share one allocation
     c, Fc = tmp[0:3], tmp[3:9]
     M[:, :] = 0.0
+    o = np.empty(3)
+    for k in range(3):
+        o[k] = r[0, k] if n else 0.0
     for i in range(n):
         # this frame's own columns come last in its (sorted) column list: columns are
         # numbered in topological order, after every ancestor's
@@ -140,15 +144,16 @@ def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc
             col = anc_idx[m]
             wx, wy, wz = JR[i, 0, col], JR[i, 1, col], JR[i, 2, col]
             S[col, 0], S[col, 1], S[col, 2] = wx, wy, wz
-            # v0 = v_origin_i - w x r_i
-            S[col, 3] = JT[i, 0, col] - (wy * r[i, 2] - wz * r[i, 1])
-            S[col, 4] = JT[i, 1, col] - (wz * r[i, 0] - wx * r[i, 2])
-            S[col, 5] = JT[i, 2, col] - (wx * r[i, 1] - wy * r[i, 0])
+            # v0 = v_origin_i - w x (r_i - o)
+            dx, dy, dz = r[i, 0] - o[0], r[i, 1] - o[1], r[i, 2] - o[2]
+            S[col, 3] = JT[i, 0, col] - (wy * dz - wz * dy)
+            S[col, 4] = JT[i, 1, col] - (wz * dx - wx * dz)
+            S[col, 5] = JT[i, 2, col] - (wx * dy - wy * dx)
         # this body's spatial inertia about the world origin
         m_i = mass[i]
         rotate_tensor(R[i], inertia[i], S3, Iw)
         mat_vec(R[i], com[i], c)
-        cx, cy, cz = c[0] + r[i, 0], c[1] + r[i, 1], c[2] + r[i, 2]
+        cx, cy, cz = c[0] + r[i, 0] - o[0], c[1] + r[i, 1] - o[1], c[2] + r[i, 2] - o[2]
         cc = cx * cx + cy * cy + cz * cz
         G = IC[i]
         G[0, 0] = Iw[0, 0] + m_i * (cc - cx * cx)

@@ -7,6 +7,7 @@ the joint-space state with drives filled in, the load values and a workspace.
 import numpy as np
 from numba import njit
 
+from .articulated import articulated_body, joint_wrenches_tree, reaction_components
 from .dynamics import applied_loads, cholesky_solve, jourdain, newton_euler_system
 from .forces import force_elements
 from .kinematics import forward_kinematics
@@ -92,3 +93,59 @@ def newton_euler_solution(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc
     newton_euler_system(mass, com, inertia, parent, R, r, w, alpha, a, JR, JT, anc_ptr, anc_idx,
                         F, N, react_joint, react_force, react_moment, A, b)
     return np.linalg.solve(A, b)
+
+
+@njit(cache=True)
+def articulated_accelerations(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr,
+                              own_idx, mass, com, inertia, gravity, qfull, ufull, udfull,
+                              load_body, load_point, load_force, load_moment, load_in_body,
+                              force_int, force_data, switches,
+                              R, r, w, v, alpha, a, JR, JT, F, N, IA, pA, cb, U, Dl, acc, ud):
+    """Kinematics, loads, then ``ud`` by the articulated-body algorithm: O(n).
+
+    ``own_ptr``/``own_idx`` list each frame's own speed columns only (in place of the
+    ancestor lists), so that the kinematics skip the O(n depth) inheritance of Jacobian
+    columns the algorithm does not read.  Returns -1 on success, the speed where a
+    degree of freedom has no inertia, or -2 when ``ud`` holds NaN or Inf.
+    """
+    kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr, own_idx,
+                         mass, com, gravity, qfull, ufull, udfull,
+                         load_body, load_point, load_force, load_moment, load_in_body,
+                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, F, N)
+    if switches[0] == 0:
+        drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr,
+                               own_idx, qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT)
+    pivot = articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha, a, JR, JT,
+                             F, N, IA, pA, cb, U, Dl, acc, ud)
+    if pivot >= 0:
+        return pivot
+    for k in range(ud.shape[0]):
+        if not np.isfinite(ud[k]):
+            return -2
+    return -1
+
+
+@njit(cache=True)
+def newton_euler_tree(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr, own_idx,
+                      mass, com, inertia, gravity, qfull, ufull, udfull,
+                      load_body, load_point, load_force, load_moment, load_in_body,
+                      force_int, force_data, switches, react_joint, react_force, react_moment,
+                      R, r, w, v, alpha, a, JR, JT, F, N, IA, pA, cb, U, Dl, acc, wrench, ud,
+                      lam):
+    """The Newton-Euler equations with reaction unknowns solved in tree order: speed rates
+    ``ud`` and reaction components ``lam`` (as ``newton_euler_solution``'s ``x``), in O(n).
+    Returns as ``articulated_accelerations`` (-2 also for non-finite reactions)."""
+    pivot = articulated_accelerations(parent, kind, axis, seq, pos, C, qoff, uoff, ucol,
+                                      own_ptr, own_idx, mass, com, inertia, gravity, qfull,
+                                      ufull, udfull, load_body, load_point, load_force,
+                                      load_moment, load_in_body, force_int, force_data,
+                                      switches, R, r, w, v, alpha, a, JR, JT, F, N, IA, pA, cb,
+                                      U, Dl, acc, ud)
+    if pivot != -1:
+        return pivot
+    joint_wrenches_tree(parent, r, IA, pA, acc, wrench)
+    reaction_components(R, react_joint, react_force, react_moment, wrench, lam)
+    for k in range(lam.shape[0]):
+        if not np.isfinite(lam[k]):
+            return -2
+    return -1

@@ -16,8 +16,9 @@ positive definite, 3 implicit midpoint's Newton iteration did not converge.
 """
 import numpy as np
 from numba import njit
+from numba.extending import overload
 
-from .evaluate import jourdain_accelerations
+from .evaluate import articulated_accelerations, jourdain_accelerations
 from .joints import coordinate_rates
 
 EULER, SEMI_IMPLICIT_EULER, RK4, IMPLICIT_MIDPOINT = 0, 1, 2, 3
@@ -33,17 +34,42 @@ def _rates(y, nq, slots, out):
     coordinate_rates(y[:nq], y[nq:], slots, out[:nq])
 
 
+def accelerations(tree, body, loads, ws, ud):
+    """``ud = u'`` by the route the workspace ``ws`` is laid out for (see
+    ``_accelerations_route``); returns as ``evaluate.jourdain_accelerations``."""
+    raise NotImplementedError("compiled code only")
+
+
+@overload(accelerations, inline="always")
+def _accelerations_route(tree, body, loads, ws, ud):
+    """The formulation is chosen when the loop is compiled, by the workspace's type: 16
+    arrays (``M``, ``f``, ``L`` last) for ``M u' = f``, 19 (the articulated-body
+    workspace last; ``tree`` then lists each frame's own speed columns) for the
+    articulated-body algorithm.  A run compiles only its own route."""
+    if len(ws) == 16:
+        def jourdain_route(tree, body, loads, ws, ud):
+            (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, F, N, M, f, L) = ws
+            return jourdain_accelerations(*tree, *body, qfull, ufull, udfull, *loads,
+                                          R, r, w, v, alpha, a, JR, JT, F, N, M, f, L, ud)
+        return jourdain_route
+
+    def articulated_route(tree, body, loads, ws, ud):
+        (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, F, N, IA, pA, cb, U, Dl,
+         acc) = ws
+        mass, com, inertia, _, gravity = body
+        return articulated_accelerations(*tree, mass, com, inertia, gravity, qfull, ufull,
+                                         udfull, *loads, R, r, w, v, alpha, a, JR, JT, F, N,
+                                         IA, pA, cb, U, Dl, acc, ud)
+    return articulated_route
+
+
 @njit(cache=True, inline="always")
 def _rhs(y, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads, ws,
          ydot, nfev):
     """``ydot = [N(q) u, M^-1 f]`` at the stage whose drive values are ``drive_vals``;
     counts the evaluation in ``nfev[0]``."""
     nfev[0] += 1
-    (parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx) = tree
-    (mass, com, inertia, has_inertia, gravity) = body
-    (load_body, load_point, load_force, load_moment, load_in_body, force_int, force_data,
-     switches) = loads
-    (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, F, N, M, f, L) = ws
+    qfull, ufull, udfull = ws[0], ws[1], ws[2]
     nu = y.shape[0] - nq
     for k in range(nq):
         qfull[free_q[k]] = y[k]
@@ -54,12 +80,7 @@ def _rhs(y, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body,
         qfull[drive_q[d]] = drive_vals[d, 0]
         ufull[drive_u[d]] = drive_vals[d, 1]
         udfull[drive_u[d]] = drive_vals[d, 2]
-    ud = ydot[nq:]
-    pivot = jourdain_accelerations(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr,
-                                   anc_idx, mass, com, inertia, has_inertia, gravity, qfull,
-                                   ufull, udfull, load_body, load_point, load_force, load_moment,
-                                   load_in_body, force_int, force_data, switches,
-                                   R, r, w, v, alpha, a, JR, JT, F, N, M, f, L, ud)
+    pivot = accelerations(tree, body, loads, ws, ydot[nq:])
     if pivot >= 0:
         return 2
     _rates(y, nq, slots, ydot)

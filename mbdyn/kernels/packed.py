@@ -15,7 +15,8 @@ given as Python functions are still written by the caller first.
 import numpy as np
 from numba import njit
 
-from .evaluate import jourdain_accelerations, newton_euler_solution
+from .evaluate import (articulated_accelerations, jourdain_accelerations, newton_euler_solution,
+                       newton_euler_tree)
 from .forces import ROW
 from .joints import coordinate_rates
 
@@ -23,11 +24,11 @@ from .joints import coordinate_rates
 FLOATS = ("gravity", "axis", "pos", "C", "mass", "com", "inertia", "load_point", "load_force",
           "load_moment", "react_force", "react_moment", "qfull", "ufull", "udfull", "R", "r",
           "w", "v", "alpha", "a", "JR", "JT", "F", "N", "M", "f", "L", "A", "b", "ud",
-          "force_data")
+          "force_data", "IA", "pA", "cb", "U", "Dl", "acc", "W", "lam")
 #: integer arrays in buffer order (the two flag arrays are stored as 0/1)
 INTS = ("parent", "kind", "seq", "qoff", "uoff", "ucol", "anc_ptr", "anc_idx", "has_inertia",
         "load_body", "load_in_body", "react_joint", "free_q", "free_u", "slots", "force_int",
-        "switches")
+        "switches", "own_ptr", "own_idx")
 #: sizes, first entries of the offset table: frames, free speeds, loads, joint-space
 #: coordinates and speeds, ancestor-column entries, reaction components, free coordinates,
 #: free joints, force elements, force-element numbers
@@ -35,9 +36,10 @@ SIZES = ("n", "nu", "nl", "nqf", "nuf", "nanc", "nreact", "nq", "nslots", "ne", 
 
 (GRAVITY, AXIS, POS, C, MASS, COM, INERTIA, LOAD_POINT, LOAD_FORCE, LOAD_MOMENT, REACT_FORCE,
  REACT_MOMENT, QFULL, UFULL, UDFULL, R, RR, W, V, ALPHA, A, JR, JT, F, N, M, FF, L, AA, B,
- UD, FORCE_DATA) = range(len(SIZES), len(SIZES) + len(FLOATS))
+ UD, FORCE_DATA, IA, PA, CB, U, DL, ACC, WRENCH, LAM) = range(len(SIZES),
+                                                                len(SIZES) + len(FLOATS))
 (PARENT, KIND, SEQ, QOFF, UOFF, UCOL, ANC_PTR, ANC_IDX, HAS_INERTIA, LOAD_BODY, LOAD_IN_BODY,
- REACT_JOINT, FREE_Q, FREE_U, SLOTS, FORCE_INT, SWITCHES) = range(len(SIZES) + len(FLOATS), len(SIZES) + len(FLOATS) + len(INTS))
+ REACT_JOINT, FREE_Q, FREE_U, SLOTS, FORCE_INT, SWITCHES, OWN_PTR, OWN_IDX) = range(len(SIZES) + len(FLOATS), len(SIZES) + len(FLOATS) + len(INTS))
 
 
 def pack(floats, ints):
@@ -76,7 +78,10 @@ def pack(floats, ints):
 def _views(fb, ib, t):
     """Every packed array as a view, in the order of the unpacked kernels' arguments:
     tree (11), body (mass, com, inertia, has_inertia, gravity), joint-space state (3),
-    loads (5, then force elements and effect switches: 3), reactions (3), motion (10), Jourdain (M, f, L, ud), Newton-Euler (A, b).
+    loads (5, then force elements and effect switches: 3), reactions (3), motion (10),
+    Jourdain (M, f, L, ud), Newton-Euler (A, b), articulated bodies (the frames' own
+    columns ``own_ptr``, ``own_idx``, then the workspace of ``articulated.articulated_body``
+    and the joint wrenches and reaction components).
     Offsets are read from ``t`` at run time: literal constants as arguments would make
     numba compile a slicing helper per constant."""
     n, nu, nl, nqf, nuf, nanc, nreact = t[0], t[1], t[2], t[3], t[4], t[5], t[6]
@@ -114,7 +119,16 @@ def _views(fb, ib, t):
                 fb[t[L]:t[L] + nu * nu].reshape((nu, nu)), fb[t[UD]:t[UD] + nu])
     newton_euler = (fb[t[AA]:t[AA] + 36 * n * n].reshape((6 * n, 6 * n)),
                     fb[t[B]:t[B] + 6 * n])
-    return tree, body, state, loads, reactions, motion, jourdain, newton_euler
+    articulated = (ib[t[OWN_PTR]:t[OWN_PTR] + n + 1], ib[t[OWN_IDX]:t[OWN_IDX] + nu],
+                   fb[t[IA]:t[IA] + 36 * n].reshape((n, 6, 6)),
+                   fb[t[PA]:t[PA] + 6 * n].reshape((n, 6)),
+                   fb[t[CB]:t[CB] + 6 * n].reshape((n, 6)),
+                   fb[t[U]:t[U] + 36 * n].reshape((n, 6, 6)),
+                   fb[t[DL]:t[DL] + 42 * n].reshape((n, 6, 7)),
+                   fb[t[ACC]:t[ACC] + 6 * n].reshape((n, 6)),
+                   fb[t[WRENCH]:t[WRENCH] + 6 * n].reshape((n, 6)),
+                   fb[t[LAM]:t[LAM] + nreact])
+    return tree, body, state, loads, reactions, motion, jourdain, newton_euler, articulated
 
 
 @njit(cache=True)
@@ -135,7 +149,7 @@ def jourdain_accelerations_packed(fb, ib, t, q, u):
     """Scatter ``q``, ``u``, then ``evaluate.jourdain_accelerations`` on packed arrays (same
     return value; ``u'`` is left in the ``ud`` view)."""
     _scatter(fb, ib, t, q, u)
-    tree, body, state, loads, _, motion, jourdain, _ = _views(fb, ib, t)
+    tree, body, state, loads, _, motion, jourdain, _, _ = _views(fb, ib, t)
     return jourdain_accelerations(*tree, *body, *state, *loads, *motion, *jourdain)
 
 
@@ -145,7 +159,7 @@ def state_derivative_packed(fb, ib, t, y, ydot):
     Cholesky factorization of ``M`` broke down, or -2 when ``ydot`` holds NaN or Inf."""
     nq, nu = t[7], t[1]
     _scatter(fb, ib, t, y[:nq], y[nq:])
-    tree, body, state, loads, _, motion, jourdain, _ = _views(fb, ib, t)
+    tree, body, state, loads, _, motion, jourdain, _, _ = _views(fb, ib, t)
     pivot = jourdain_accelerations(*tree, *body, *state, *loads, *motion, *jourdain)
     if pivot >= 0:
         return pivot
@@ -165,7 +179,7 @@ def newton_euler_solution_packed(fb, ib, t, q, u):
     """Scatter ``q``, ``u``, then ``evaluate.newton_euler_solution`` on packed arrays.
     Returns the unknowns ``x = [ud, lambda]`` (a new array) and whether all are finite."""
     _scatter(fb, ib, t, q, u)
-    tree, body, state, loads, reactions, motion, _, newton_euler = _views(fb, ib, t)
+    tree, body, state, loads, reactions, motion, _, newton_euler, _ = _views(fb, ib, t)
     mass, com, inertia, _, gravity = body
     x = newton_euler_solution(*tree, mass, com, inertia, gravity, *state, *loads,
                               *reactions, *motion, *newton_euler)
@@ -173,3 +187,44 @@ def newton_euler_solution_packed(fb, ib, t, q, u):
     for k in range(x.shape[0]):
         finite = finite and np.isfinite(x[k])
     return x, finite
+
+
+@njit(cache=True)
+def articulated_accelerations_packed(fb, ib, t, q, u):
+    """Scatter ``q``, ``u``, then ``evaluate.articulated_accelerations`` on packed arrays
+    (same return value; ``u'`` is left in the ``ud`` view)."""
+    _scatter(fb, ib, t, q, u)
+    tree, body, state, loads, _, motion, jourdain, _, art = _views(fb, ib, t)
+    mass, com, inertia, _, gravity = body
+    return articulated_accelerations(*tree[:9], *art[:2], mass, com, inertia, gravity, *state,
+                                     *loads, *motion, *art[2:8], jourdain[3])
+
+
+@njit(cache=True)
+def state_derivative_articulated_packed(fb, ib, t, y, ydot):
+    """``state_derivative_packed`` with ``u'`` by the articulated-body algorithm."""
+    nq, nu = t[7], t[1]
+    pivot = articulated_accelerations_packed(fb, ib, t, y[:nq], y[nq:])
+    if pivot >= 0:
+        return pivot
+    ud = fb[t[UD]:t[UD] + nu]
+    for k in range(nu):
+        ydot[nq + k] = ud[k]
+    coordinate_rates(y[:nq], y[nq:], ib[t[SLOTS]:t[SLOTS] + 5 * t[8]].reshape((t[8], 5)),
+                     ydot[:nq])
+    for k in range(ydot.shape[0]):
+        if not np.isfinite(ydot[k]):
+            return -2
+    return -1
+
+
+@njit(cache=True)
+def newton_euler_tree_packed(fb, ib, t, q, u):
+    """Scatter ``q``, ``u``, then ``evaluate.newton_euler_tree`` on packed arrays: ``u'``
+    in the ``ud`` view, the reaction components in ``lam``; same return value."""
+    _scatter(fb, ib, t, q, u)
+    tree, body, state, loads, reactions, motion, jourdain, _, art = _views(fb, ib, t)
+    mass, com, inertia, _, gravity = body
+    return newton_euler_tree(*tree[:9], *art[:2], mass, com, inertia, gravity, *state, *loads,
+                             *reactions, *motion, *art[2:9], jourdain[3], art[9])
+
