@@ -31,57 +31,59 @@ from .joints import NU
 
 
 @njit(cache=True, inline="always")
-def _spatial_inertia(m, c, Iw, out):
+def _spatial_inertia(m, c, Iw, IA, i):
     """Spatial inertia at the frame origin (world axes) of a body of mass ``m``, centre of
-    mass at ``c`` from the origin and inertia ``Iw`` about the centre of mass:
-    ``[[Iw - m [c]x [c]x, m [c]x], [-m [c]x, m E]]``."""
+    mass at ``c`` from the origin and inertia ``Iw`` about the centre of mass, into
+    ``IA[i]``: ``[[Iw - m [c]x [c]x, m [c]x], [-m [c]x, m E]]``.  (Arrays are indexed
+    with the frame number rather than passed as ``IA[i]`` views: a view costs two
+    reference-count calls, which dominated the cost of a small model.)"""
     cx, cy, cz = c[0], c[1], c[2]
     cc = cx * cx + cy * cy + cz * cz
-    out[0, 0] = Iw[0, 0] + m * (cc - cx * cx)
-    out[1, 1] = Iw[1, 1] + m * (cc - cy * cy)
-    out[2, 2] = Iw[2, 2] + m * (cc - cz * cz)
-    out[0, 1] = out[1, 0] = Iw[0, 1] - m * cx * cy
-    out[0, 2] = out[2, 0] = Iw[0, 2] - m * cx * cz
-    out[1, 2] = out[2, 1] = Iw[1, 2] - m * cy * cz
+    IA[i, 0, 0] = Iw[0, 0] + m * (cc - cx * cx)
+    IA[i, 1, 1] = Iw[1, 1] + m * (cc - cy * cy)
+    IA[i, 2, 2] = Iw[2, 2] + m * (cc - cz * cz)
+    IA[i, 0, 1] = IA[i, 1, 0] = Iw[0, 1] - m * cx * cy
+    IA[i, 0, 2] = IA[i, 2, 0] = Iw[0, 2] - m * cx * cz
+    IA[i, 1, 2] = IA[i, 2, 1] = Iw[1, 2] - m * cy * cz
     for a_ in range(3):
         for b_ in range(3):
-            out[3 + a_, 3 + b_] = m if a_ == b_ else 0.0
-    out[0, 3], out[0, 4], out[0, 5] = 0.0, -m * cz, m * cy
-    out[1, 3], out[1, 4], out[1, 5] = m * cz, 0.0, -m * cx
-    out[2, 3], out[2, 4], out[2, 5] = -m * cy, m * cx, 0.0
+            IA[i, 3 + a_, 3 + b_] = m if a_ == b_ else 0.0
+    IA[i, 0, 3], IA[i, 0, 4], IA[i, 0, 5] = 0.0, -m * cz, m * cy
+    IA[i, 1, 3], IA[i, 1, 4], IA[i, 1, 5] = m * cz, 0.0, -m * cx
+    IA[i, 2, 3], IA[i, 2, 4], IA[i, 2, 5] = -m * cy, m * cx, 0.0
     for a_ in range(3):
         for b_ in range(3):
-            out[3 + b_, a_] = out[a_, 3 + b_]
+            IA[i, 3 + b_, a_] = IA[i, a_, 3 + b_]
 
 
 @njit(cache=True, inline="always")
-def _add_shifted_inertia(Ia, rho, Y, out):
-    """``out += X^T Ia X``: a child's articulated inertia moved from its origin to its
+def _add_shifted_inertia(IA, i, p, rho, Y):
+    """``IA[p] += X^T IA[i] X``: a child's articulated inertia moved from its origin to its
     parent's, ``rho`` being the child's origin from the parent's.  With
-    ``Ia = [[A, B], [B^T, C]]`` and ``P = [rho]x``: ``[[A - B P + P B^T - P C P, B + P C],
+    ``IA[i] = [[A, B], [B^T, C]]`` and ``P = [rho]x``: ``[[A - B P + P B^T - P C P, B + P C],
     [B^T - C P, C]]``.  ``Y`` (6x3) is scratch."""
     x, y, z = rho[0], rho[1], rho[2]
     # Y = Ia X: the first three columns are Ia[:, 0:3] - Ia[:, 3:6] P, the rest Ia[:, 3:6]
     for r_ in range(6):
-        b0, b1, b2 = Ia[r_, 3], Ia[r_, 4], Ia[r_, 5]
+        b0, b1, b2 = IA[i, r_, 3], IA[i, r_, 4], IA[i, r_, 5]
         # (row of Ia[:, 3:6]) P, with P = [[0, -z, y], [z, 0, -x], [-y, x, 0]]
-        Y[r_, 0] = Ia[r_, 0] - (b1 * z - b2 * y)
-        Y[r_, 1] = Ia[r_, 1] - (-b0 * z + b2 * x)
-        Y[r_, 2] = Ia[r_, 2] - (b0 * y - b1 * x)
+        Y[r_, 0] = IA[i, r_, 0] - (b1 * z - b2 * y)
+        Y[r_, 1] = IA[i, r_, 1] - (-b0 * z + b2 * x)
+        Y[r_, 2] = IA[i, r_, 2] - (b0 * y - b1 * x)
     # X^T Y: rows 0..2 gain P times rows 3..5
     for col in range(6):
         if col < 3:
             l0, l1, l2 = Y[3, col], Y[4, col], Y[5, col]
             u0, u1, u2 = Y[0, col], Y[1, col], Y[2, col]
         else:
-            l0, l1, l2 = Ia[3, col], Ia[4, col], Ia[5, col]
-            u0, u1, u2 = Ia[0, col], Ia[1, col], Ia[2, col]
-        out[0, col] += u0 + (y * l2 - z * l1)
-        out[1, col] += u1 + (z * l0 - x * l2)
-        out[2, col] += u2 + (x * l1 - y * l0)
-        out[3, col] += l0
-        out[4, col] += l1
-        out[5, col] += l2
+            l0, l1, l2 = IA[i, 3, col], IA[i, 4, col], IA[i, 5, col]
+            u0, u1, u2 = IA[i, 0, col], IA[i, 1, col], IA[i, 2, col]
+        IA[p, 0, col] += u0 + (y * l2 - z * l1)
+        IA[p, 1, col] += u1 + (z * l0 - x * l2)
+        IA[p, 2, col] += u2 + (x * l1 - y * l0)
+        IA[p, 3, col] += l0
+        IA[p, 4, col] += l1
+        IA[p, 5, col] += l2
 
 
 @njit(cache=True)
@@ -108,22 +110,24 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
     Y = np.empty((6, 3))
     tmp = np.empty(24)                   # the vector temporaries share one allocation
     c, wc, t1, t2 = tmp[0:3], tmp[3:6], tmp[6:9], tmp[9:12]
-    rho, v6, Sx = tmp[12:15], tmp[15:21], tmp[21:24]
+    rho, v6, wv = tmp[12:15], tmp[15:21], tmp[21:24]
     # -- every body on its own: spatial inertia, velocity-product and applied wrench
     for i in range(n):
-        Ri = R[i]
         for a_ in range(3):
-            c[a_] = Ri[a_, 0] * com[i, 0] + Ri[a_, 1] * com[i, 1] + Ri[a_, 2] * com[i, 2]
+            c[a_] = R[i, a_, 0] * com[i, 0] + R[i, a_, 1] * com[i, 1] + R[i, a_, 2] * com[i, 2]
         for a_ in range(3):              # Iw = R I R^T
             for b_ in range(3):
                 s = 0.0
                 for k in range(3):
-                    s += Ri[a_, k] * (inertia[i, k, 0] * Ri[b_, 0] + inertia[i, k, 1] * Ri[b_, 1]
-                                      + inertia[i, k, 2] * Ri[b_, 2])
+                    s += R[i, a_, k] * (inertia[i, k, 0] * R[i, b_, 0]
+                                        + inertia[i, k, 1] * R[i, b_, 1]
+                                        + inertia[i, k, 2] * R[i, b_, 2])
                 Iw[a_, b_] = s
         m_i = mass[i]
-        _spatial_inertia(m_i, c, Iw, IA[i])
-        wi = w[i]
+        _spatial_inertia(m_i, c, Iw, IA, i)
+        wi = wv
+        for a_ in range(3):
+            wi[a_] = w[i, a_]
         # w x (w x c): centripetal acceleration of the centre of mass relative to O_i
         wc[0] = wi[1] * c[2] - wi[2] * c[1]
         wc[1] = wi[2] * c[0] - wi[0] * c[2]
@@ -147,13 +151,13 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
         if p >= 0:
             for a_ in range(3):
                 rho[a_] = r[i, a_] - r[p, a_]
-            ap = alpha_b[p]
-            cb[i, 0] = alpha_b[i, 0] - ap[0]
-            cb[i, 1] = alpha_b[i, 1] - ap[1]
-            cb[i, 2] = alpha_b[i, 2] - ap[2]
-            cb[i, 3] = a_b[i, 0] - a_b[p, 0] - (ap[1] * rho[2] - ap[2] * rho[1])
-            cb[i, 4] = a_b[i, 1] - a_b[p, 1] - (ap[2] * rho[0] - ap[0] * rho[2])
-            cb[i, 5] = a_b[i, 2] - a_b[p, 2] - (ap[0] * rho[1] - ap[1] * rho[0])
+            ap0, ap1, ap2 = alpha_b[p, 0], alpha_b[p, 1], alpha_b[p, 2]
+            cb[i, 0] = alpha_b[i, 0] - ap0
+            cb[i, 1] = alpha_b[i, 1] - ap1
+            cb[i, 2] = alpha_b[i, 2] - ap2
+            cb[i, 3] = a_b[i, 0] - a_b[p, 0] - (ap1 * rho[2] - ap2 * rho[1])
+            cb[i, 4] = a_b[i, 1] - a_b[p, 1] - (ap2 * rho[0] - ap0 * rho[2])
+            cb[i, 5] = a_b[i, 2] - a_b[p, 2] - (ap0 * rho[1] - ap1 * rho[0])
         else:
             for a_ in range(3):
                 cb[i, a_] = alpha_b[i, a_]
@@ -163,16 +167,14 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
     for i in range(n - 1, -1, -1):
         col0 = ucol[i]
         k = NU[kind[i]] if col0 >= 0 else 0
-        Ii = IA[i]
         if k:
             # U = IA S, D = S^T U, and D's Cholesky factor in Dl[i, :k, :k]
             for j in range(k):
                 col = col0 + j
                 for a_ in range(6):
-                    U[i, a_, j] = (Ii[a_, 0] * JR[i, 0, col] + Ii[a_, 1] * JR[i, 1, col]
-                                   + Ii[a_, 2] * JR[i, 2, col] + Ii[a_, 3] * JT[i, 0, col]
-                                   + Ii[a_, 4] * JT[i, 1, col] + Ii[a_, 5] * JT[i, 2, col])
-            L = Dl[i]
+                    U[i, a_, j] = (IA[i, a_, 0] * JR[i, 0, col] + IA[i, a_, 1] * JR[i, 1, col]
+                                   + IA[i, a_, 2] * JR[i, 2, col] + IA[i, a_, 3] * JT[i, 0, col]
+                                   + IA[i, a_, 4] * JT[i, 1, col] + IA[i, a_, 5] * JT[i, 2, col])
             for j in range(k):
                 for m in range(j + 1):
                     col = col0 + m
@@ -180,14 +182,14 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
                          + JR[i, 2, col] * U[i, 2, j] + JT[i, 0, col] * U[i, 3, j]
                          + JT[i, 1, col] * U[i, 4, j] + JT[i, 2, col] * U[i, 5, j])
                     for l_ in range(m):
-                        s -= L[j, l_] * L[m, l_]
+                        s -= Dl[i, j, l_] * Dl[i, m, l_]
                     if m == j:
                         if not s > 0.0:
                             return col0 + j
                         largest = max(largest, s)
-                        L[j, j] = np.sqrt(s)
+                        Dl[i, j, j] = np.sqrt(s)
                     else:
-                        L[j, m] = s / L[m, m]
+                        Dl[i, j, m] = s / Dl[i, m, m]
             # the joint's own equations: S^T (IA A + pA) = 0  ->  u' = D^-1 (uv - U^T X A_p)
             # keep z = D^-1 (-S^T pA) in Dl[i, :k, 6]
             for j in range(k):
@@ -195,36 +197,36 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
                 v6[j] = -(JR[i, 0, col] * pA[i, 0] + JR[i, 1, col] * pA[i, 1]
                           + JR[i, 2, col] * pA[i, 2] + JT[i, 0, col] * pA[i, 3]
                           + JT[i, 1, col] * pA[i, 4] + JT[i, 2, col] * pA[i, 5])
-            _cholesky_solve_small(L, k, v6)
+            _cholesky_solve_small(Dl, i, k, v6)
             for j in range(k):
-                L[j, 6] = v6[j]
+                Dl[i, j, 6] = v6[j]
             # Ia = IA - U D^-1 U^T ; pa = pA + Ia c + U D^-1 (-S^T pA)
             for a_ in range(6):
                 for j in range(k):
                     v6[j] = U[i, a_, j]
-                _cholesky_solve_small(L, k, v6)          # D^-1 U^T[:, a]
+                _cholesky_solve_small(Dl, i, k, v6)          # D^-1 U^T[:, a]
                 for b_ in range(a_, 6):
                     s = 0.0
                     for j in range(k):
                         s += U[i, b_, j] * v6[j]
-                    Ii[a_, b_] -= s
+                    IA[i, a_, b_] -= s
                     if b_ != a_:
-                        Ii[b_, a_] = Ii[a_, b_]
+                        IA[i, b_, a_] = IA[i, a_, b_]
             for a_ in range(6):
                 s = 0.0
                 for j in range(k):
-                    s += U[i, a_, j] * L[j, 6]
+                    s += U[i, a_, j] * Dl[i, j, 6]
                 pA[i, a_] += s
         for a_ in range(6):
             s = 0.0
             for b_ in range(6):
-                s += Ii[a_, b_] * cb[i, b_]
+                s += IA[i, a_, b_] * cb[i, b_]
             pA[i, a_] += s
         p = parent[i]
         if p >= 0:
             for a_ in range(3):
                 rho[a_] = r[i, a_] - r[p, a_]
-            _add_shifted_inertia(Ii, rho, Y, IA[p])
+            _add_shifted_inertia(IA, i, p, rho, Y)
             f0, f1, f2 = pA[i, 3], pA[i, 4], pA[i, 5]
             pA[p, 0] += pA[i, 0] + rho[1] * f2 - rho[2] * f1
             pA[p, 1] += pA[i, 1] + rho[2] * f0 - rho[0] * f2
@@ -245,52 +247,48 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
         if p >= 0:
             for a_ in range(3):
                 rho[a_] = r[i, a_] - r[p, a_]
-            ap = acc[p]
-            acc[i, 0] = ap[0] + cb[i, 0]
-            acc[i, 1] = ap[1] + cb[i, 1]
-            acc[i, 2] = ap[2] + cb[i, 2]
-            acc[i, 3] = ap[3] + ap[1] * rho[2] - ap[2] * rho[1] + cb[i, 3]
-            acc[i, 4] = ap[4] + ap[2] * rho[0] - ap[0] * rho[2] + cb[i, 4]
-            acc[i, 5] = ap[5] + ap[0] * rho[1] - ap[1] * rho[0] + cb[i, 5]
+            acc[i, 0] = acc[p, 0] + cb[i, 0]
+            acc[i, 1] = acc[p, 1] + cb[i, 1]
+            acc[i, 2] = acc[p, 2] + cb[i, 2]
+            acc[i, 3] = acc[p, 3] + acc[p, 1] * rho[2] - acc[p, 2] * rho[1] + cb[i, 3]
+            acc[i, 4] = acc[p, 4] + acc[p, 2] * rho[0] - acc[p, 0] * rho[2] + cb[i, 4]
+            acc[i, 5] = acc[p, 5] + acc[p, 0] * rho[1] - acc[p, 1] * rho[0] + cb[i, 5]
         else:
             for a_ in range(6):
                 acc[i, a_] = cb[i, a_]
         col0 = ucol[i]
         if col0 >= 0:
             k = NU[kind[i]]
-            L = Dl[i]
             # u' = D^-1 (-S^T pA) - D^-1 U^T (X A_p + c)
             for j in range(k):
                 s = 0.0
                 for a_ in range(6):
                     s += U[i, a_, j] * acc[i, a_]
                 v6[j] = s
-            _cholesky_solve_small(L, k, v6)
+            _cholesky_solve_small(Dl, i, k, v6)
             for j in range(k):
                 col = col0 + j
-                udj = L[j, 6] - v6[j]
+                udj = Dl[i, j, 6] - v6[j]
                 ud[col] = udj
                 for a_ in range(3):
-                    Sx[a_] = JR[i, a_, col]
-                for a_ in range(3):
-                    acc[i, a_] += Sx[a_] * udj
+                    acc[i, a_] += JR[i, a_, col] * udj
                     acc[i, 3 + a_] += JT[i, a_, col] * udj
     return -1
 
 
 @njit(cache=True, inline="always")
-def _cholesky_solve_small(L, k, x):
-    """``x <- D^-1 x`` for ``D = L L^T``, ``L`` lower triangular in ``L[:k, :k]``."""
+def _cholesky_solve_small(Dl, f, k, x):
+    """``x <- D^-1 x`` for ``D = L L^T``, ``L`` lower triangular in ``Dl[f, :k, :k]``."""
     for i in range(k):
         s = x[i]
         for j in range(i):
-            s -= L[i, j] * x[j]
-        x[i] = s / L[i, i]
+            s -= Dl[f, i, j] * x[j]
+        x[i] = s / Dl[f, i, i]
     for i in range(k - 1, -1, -1):
         s = x[i]
         for j in range(i + 1, k):
-            s -= L[j, i] * x[j]
-        x[i] = s / L[i, i]
+            s -= Dl[f, j, i] * x[j]
+        x[i] = s / Dl[f, i, i]
 
 
 @njit(cache=True)
@@ -303,19 +301,17 @@ def joint_wrenches_tree(parent, r, IA, pA, acc, out):
     v = np.empty(6)
     for i in range(n):
         p = parent[i]
-        Ii = IA[i]
         v[:] = 0.0
         if p >= 0:
-            ap = acc[p]
             rx, ry, rz = r[i, 0] - r[p, 0], r[i, 1] - r[p, 1], r[i, 2] - r[p, 2]
-            v[0], v[1], v[2] = ap[0], ap[1], ap[2]
-            v[3] = ap[3] + ap[1] * rz - ap[2] * ry
-            v[4] = ap[4] + ap[2] * rx - ap[0] * rz
-            v[5] = ap[5] + ap[0] * ry - ap[1] * rx
+            v[0], v[1], v[2] = acc[p, 0], acc[p, 1], acc[p, 2]
+            v[3] = acc[p, 3] + acc[p, 1] * rz - acc[p, 2] * ry
+            v[4] = acc[p, 4] + acc[p, 2] * rx - acc[p, 0] * rz
+            v[5] = acc[p, 5] + acc[p, 0] * ry - acc[p, 1] * rx
         for a_ in range(6):
             s = pA[i, a_]
             for b_ in range(6):
-                s += Ii[a_, b_] * v[b_]
+                s += IA[i, a_, b_] * v[b_]
             # (moment, force) -> out (force, moment)
             if a_ < 3:
                 out[i, 3 + a_] = s

@@ -38,18 +38,27 @@ def forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_pt
     ``JT[i]`` are zero and are never written, so the caller zeroes them once.
     """
     n = parent.shape[0]
+    # Per-frame rows are copied into this scratch, element by element, rather than passed
+    # on as views (R[p], w[p], ...): in a loop this long numba cannot prune a view's two
+    # reference-count calls, and those cost more than the arithmetic of a small model.
     Rrel = np.empty((3, 3))
     RJ0 = np.empty((3, 3))
+    Rp = np.empty((3, 3))
+    Ri = np.empty((3, 3))
+    Ci = np.empty((3, 3))
     Hw = np.empty((3, MAX_NU))
     Hv = np.empty((3, MAX_NU))
     Sm = np.empty((4, 3, 3))
     Sv = np.empty((8, 3))
+    seqi = np.empty(3, np.int64)
     # the vector temporaries share one allocation (each np.empty costs about 40 ns)
-    tmp = np.empty(14 * 3)
+    tmp = np.empty(19 * 3 + 7 + 6 + 6)
     d, hw, hv, rho = tmp[0:3], tmp[3:6], tmp[6:9], tmp[9:12]
     wrel_b, dwrel_b, vrel_j, dvrel_j = tmp[12:15], tmp[15:18], tmp[18:21], tmp[21:24]
     wrel, vrel, t1, t2 = tmp[24:27], tmp[27:30], tmp[30:33], tmp[33:36]
-    t3, t4 = tmp[36:39], tmp[39:42]
+    t3, t4, axi, posi = tmp[36:39], tmp[39:42], tmp[42:45], tmp[45:48]
+    wp, alp, wrk = tmp[48:51], tmp[51:54], tmp[54:57]
+    qj, uj, udj = tmp[57:64], tmp[64:70], tmp[70:76]
     for i in range(n):
         p = parent[i]
         k0 = qoff[i]
@@ -57,19 +66,37 @@ def forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_pt
         kd = kind[i]
         nu = 0 if kd == 0 else (1 if kd <= 2 else (3 if kd <= 4 else 6))
         nq = 0 if kd == 0 else (1 if kd <= 2 else (3 if kd == 3 else (4 if kd == 4 else 7)))
-        qj = qfull[k0:k0 + nq]
-        uj = ufull[j0:j0 + nu]
-        udj = udfull[j0:j0 + nu]
-        joint_motion(kd, axis[i], seq[i], qj, uj, Rrel, d, Hw, Hv, hw, hv, Sm, Sv)
+        for k in range(nq):
+            qj[k] = qfull[k0 + k]
+        for k in range(nu):
+            uj[k] = ufull[j0 + k]
+            udj[k] = udfull[j0 + k]
+        for k in range(3):
+            axi[k] = axis[i, k]
+            seqi[k] = seq[i, k]
+            posi[k] = pos[i, k]
+            for m in range(3):
+                Ci[k, m] = C[i, k, m]
+        joint_motion(kd, axi, seqi, qj[:nq], uj[:nu], Rrel, d, Hw, Hv, hw, hv, Sm, Sv)
 
         # orientation and position: J0 = parent (x) placement, child = J0 (x) joint
         if p >= 0:
-            mat_mat(R[p], C[i], RJ0)
-            mat_vec(R[p], pos[i], rho)
+            for k in range(3):
+                wp[k] = w[p, k]
+                alp[k] = alpha[p, k]
+                for m in range(3):
+                    Rp[k, m] = R[p, k, m]
+            mat_mat(Rp, Ci, RJ0)
+            mat_vec(Rp, posi, rho)
         else:
-            RJ0[:, :] = C[i]
-            rho[:] = pos[i]
-        mat_mat(RJ0, Rrel, R[i])
+            for k in range(3):
+                rho[k] = posi[k]
+                for m in range(3):
+                    RJ0[k, m] = Ci[k, m]
+        mat_mat(RJ0, Rrel, Ri)
+        for k in range(3):
+            for m in range(3):
+                R[i, k, m] = Ri[k, m]
         mat_vec(RJ0, d, t1)
         for k in range(3):
             rho[k] += t1[k]                   # parent origin -> child origin
@@ -85,12 +112,11 @@ def forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_pt
                 dwrel_b[k] += Hw[k, c] * udj[c]
                 vrel_j[k] += Hv[k, c] * uj[c]
                 dvrel_j[k] += Hv[k, c] * udj[c]
-        mat_vec(R[i], wrel_b, wrel)
+        mat_vec(Ri, wrel_b, wrel)
         mat_vec(RJ0, vrel_j, vrel)
-        mat_vec(R[i], dwrel_b, t3)            # relative angular acceleration, world
+        mat_vec(Ri, dwrel_b, t3)              # relative angular acceleration, world
         mat_vec(RJ0, dvrel_j, t4)             # relative acceleration, world
         if p >= 0:
-            wp = w[p]
             cross_to(wp, rho, t1)
             for k in range(3):
                 r[i, k] = r[p, k] + rho[k]
@@ -99,12 +125,12 @@ def forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_pt
             # alpha = alpha_p + w_p x w_rel + R dw_rel
             cross_to(wp, wrel, t2)
             for k in range(3):
-                alpha[i, k] = alpha[p, k] + t2[k] + t3[k]
+                alpha[i, k] = alp[k] + t2[k] + t3[k]
             # a = a_p + alpha_p x rho + w_p x (w_p x rho) + 2 w_p x v_rel + RJ0 d''
             cross_to(wp, t1, t2)              # w_p x (w_p x rho)
             for k in range(3):
                 t4[k] += t2[k]
-            cross_to(alpha[p], rho, t2)
+            cross_to(alp, rho, t2)
             for k in range(3):
                 t4[k] += t2[k]
             cross_to(wp, vrel, t2)
@@ -131,7 +157,6 @@ def forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_pt
                 JT[i, 1, col] = JT[p, 1, col] + jr2 * rho[0] - jr0 * rho[2]
                 JT[i, 2, col] = JT[p, 2, col] + jr0 * rho[1] - jr1 * rho[0]
         if ucol[i] >= 0:
-            Ri = R[i]
             for c in range(nu):
                 col = ucol[i] + c
                 for k in range(3):
