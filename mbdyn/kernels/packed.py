@@ -13,7 +13,11 @@ state (what ``Model._fill`` does in Python for the other evaluations); drives an
 given as Python functions are still written by the caller first.
 """
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.core import cgutils
+from numba.core.imputils import impl_ret_untracked
+from numba.extending import intrinsic
+from numba.np.arrayobj import make_array, populate_array
 
 from .evaluate import (articulated_accelerations, jourdain_accelerations, newton_euler_solution,
                        newton_euler_tree)
@@ -40,6 +44,38 @@ SIZES = ("n", "nu", "nl", "nqf", "nuf", "nanc", "nreact", "nq", "nslots", "ne", 
                                                                 len(SIZES) + len(FLOATS))
 (PARENT, KIND, SEQ, QOFF, UOFF, UCOL, ANC_PTR, ANC_IDX, HAS_INERTIA, LOAD_BODY, LOAD_IN_BODY,
  REACT_JOINT, FREE_Q, FREE_U, SLOTS, FORCE_INT, SWITCHES, OWN_PTR, OWN_IDX) = range(len(SIZES) + len(FLOATS), len(SIZES) + len(FLOATS) + len(INTS))
+
+
+@intrinsic
+def c_view(typingctx, buf, start, shape):
+    """``buf[start:start + prod(shape)].reshape(shape)`` for a 1-d C-contiguous ``buf``,
+    built directly (numba's ``reshape`` calls a C helper, about 25 ns: a tenth of a small
+    model's evaluation over the 60 views of ``_views``).  No bounds check: the offsets
+    come from ``pack``.  The view shares ``buf``'s memory but holds no reference to it
+    (no reference counting either, which costs as much again): it must not outlive the
+    call that made it -- the packed kernels only use their views inside."""
+    if not (isinstance(buf, types.Array) and buf.ndim == 1 and buf.layout == "C"
+            and isinstance(shape, types.UniTuple) and isinstance(start, types.Integer)):
+        return None
+    ndim = shape.count
+    view_type = types.Array(buf.dtype, ndim, "C")
+
+    def codegen(context, builder, sig, args):
+        src = make_array(sig.args[0])(context, builder, args[0])
+        shapes = cgutils.unpack_tuple(builder, args[2], ndim)
+        strides = [None] * ndim
+        stride = src.itemsize
+        for k in range(ndim - 1, -1, -1):           # C order
+            strides[k] = stride
+            stride = builder.mul(stride, shapes[k])
+        first = context.cast(builder, args[1], sig.args[1], types.intp)
+        out = make_array(view_type)(context, builder)
+        null = cgutils.get_null_value(src.meminfo.type)
+        populate_array(out, data=builder.gep(src.data, [first]), shape=shapes,
+                       strides=strides, itemsize=src.itemsize, meminfo=null,
+                       parent=cgutils.get_null_value(src.parent.type))
+        return impl_ret_untracked(context, builder, view_type, out._getvalue())
+    return view_type(buf, start, shape), codegen
 
 
 def pack(floats, ints):
@@ -86,47 +122,47 @@ def _views(fb, ib, t):
     numba compile a slicing helper per constant."""
     n, nu, nl, nqf, nuf, nanc, nreact = t[0], t[1], t[2], t[3], t[4], t[5], t[6]
     tree = (ib[t[PARENT]:t[PARENT] + n], ib[t[KIND]:t[KIND] + n],
-            fb[t[AXIS]:t[AXIS] + 3 * n].reshape((n, 3)),
-            ib[t[SEQ]:t[SEQ] + 3 * n].reshape((n, 3)),
-            fb[t[POS]:t[POS] + 3 * n].reshape((n, 3)),
-            fb[t[C]:t[C] + 9 * n].reshape((n, 3, 3)),
+            c_view(fb, t[AXIS], (n, 3)),
+            c_view(ib, t[SEQ], (n, 3)),
+            c_view(fb, t[POS], (n, 3)),
+            c_view(fb, t[C], (n, 3, 3)),
             ib[t[QOFF]:t[QOFF] + n], ib[t[UOFF]:t[UOFF] + n], ib[t[UCOL]:t[UCOL] + n],
             ib[t[ANC_PTR]:t[ANC_PTR] + n + 1], ib[t[ANC_IDX]:t[ANC_IDX] + nanc])
-    body = (fb[t[MASS]:t[MASS] + n], fb[t[COM]:t[COM] + 3 * n].reshape((n, 3)),
-            fb[t[INERTIA]:t[INERTIA] + 9 * n].reshape((n, 3, 3)),
+    body = (fb[t[MASS]:t[MASS] + n], c_view(fb, t[COM], (n, 3)),
+            c_view(fb, t[INERTIA], (n, 3, 3)),
             ib[t[HAS_INERTIA]:t[HAS_INERTIA] + n] != 0, fb[t[GRAVITY]:t[GRAVITY] + 3])
     state = (fb[t[QFULL]:t[QFULL] + nqf], fb[t[UFULL]:t[UFULL] + nuf],
              fb[t[UDFULL]:t[UDFULL] + nuf])
     loads = (ib[t[LOAD_BODY]:t[LOAD_BODY] + nl],
-             fb[t[LOAD_POINT]:t[LOAD_POINT] + 3 * nl].reshape((nl, 3)),
-             fb[t[LOAD_FORCE]:t[LOAD_FORCE] + 3 * nl].reshape((nl, 3)),
-             fb[t[LOAD_MOMENT]:t[LOAD_MOMENT] + 3 * nl].reshape((nl, 3)),
+             c_view(fb, t[LOAD_POINT], (nl, 3)),
+             c_view(fb, t[LOAD_FORCE], (nl, 3)),
+             c_view(fb, t[LOAD_MOMENT], (nl, 3)),
              ib[t[LOAD_IN_BODY]:t[LOAD_IN_BODY] + nl] != 0,
-             ib[t[FORCE_INT]:t[FORCE_INT] + ROW * t[9]].reshape((t[9], ROW)),
+             c_view(ib, t[FORCE_INT], (t[9], ROW)),
              fb[t[FORCE_DATA]:t[FORCE_DATA] + t[10]], ib[t[SWITCHES]:t[SWITCHES] + 1])
     reactions = (ib[t[REACT_JOINT]:t[REACT_JOINT] + nreact],
-                 fb[t[REACT_FORCE]:t[REACT_FORCE] + 3 * nreact].reshape((nreact, 3)),
-                 fb[t[REACT_MOMENT]:t[REACT_MOMENT] + 3 * nreact].reshape((nreact, 3)))
-    motion = (fb[t[R]:t[R] + 9 * n].reshape((n, 3, 3)),
-              fb[t[RR]:t[RR] + 3 * n].reshape((n, 3)), fb[t[W]:t[W] + 3 * n].reshape((n, 3)),
-              fb[t[V]:t[V] + 3 * n].reshape((n, 3)),
-              fb[t[ALPHA]:t[ALPHA] + 3 * n].reshape((n, 3)),
-              fb[t[A]:t[A] + 3 * n].reshape((n, 3)),
-              fb[t[JR]:t[JR] + 3 * n * nu].reshape((n, 3, nu)),
-              fb[t[JT]:t[JT] + 3 * n * nu].reshape((n, 3, nu)),
-              fb[t[F]:t[F] + 3 * n].reshape((n, 3)), fb[t[N]:t[N] + 3 * n].reshape((n, 3)))
-    jourdain = (fb[t[M]:t[M] + nu * nu].reshape((nu, nu)), fb[t[FF]:t[FF] + nu],
-                fb[t[L]:t[L] + nu * nu].reshape((nu, nu)), fb[t[UD]:t[UD] + nu])
-    newton_euler = (fb[t[AA]:t[AA] + 36 * n * n].reshape((6 * n, 6 * n)),
+                 c_view(fb, t[REACT_FORCE], (nreact, 3)),
+                 c_view(fb, t[REACT_MOMENT], (nreact, 3)))
+    motion = (c_view(fb, t[R], (n, 3, 3)),
+              c_view(fb, t[RR], (n, 3)), c_view(fb, t[W], (n, 3)),
+              c_view(fb, t[V], (n, 3)),
+              c_view(fb, t[ALPHA], (n, 3)),
+              c_view(fb, t[A], (n, 3)),
+              c_view(fb, t[JR], (n, 3, nu)),
+              c_view(fb, t[JT], (n, 3, nu)),
+              c_view(fb, t[F], (n, 3)), c_view(fb, t[N], (n, 3)))
+    jourdain = (c_view(fb, t[M], (nu, nu)), fb[t[FF]:t[FF] + nu],
+                c_view(fb, t[L], (nu, nu)), fb[t[UD]:t[UD] + nu])
+    newton_euler = (c_view(fb, t[AA], (6 * n, 6 * n)),
                     fb[t[B]:t[B] + 6 * n])
     articulated = (ib[t[OWN_PTR]:t[OWN_PTR] + n + 1], ib[t[OWN_IDX]:t[OWN_IDX] + nu],
-                   fb[t[IA]:t[IA] + 36 * n].reshape((n, 6, 6)),
-                   fb[t[PA]:t[PA] + 6 * n].reshape((n, 6)),
-                   fb[t[CB]:t[CB] + 6 * n].reshape((n, 6)),
-                   fb[t[U]:t[U] + 36 * n].reshape((n, 6, 6)),
-                   fb[t[DL]:t[DL] + 42 * n].reshape((n, 6, 7)),
-                   fb[t[ACC]:t[ACC] + 6 * n].reshape((n, 6)),
-                   fb[t[WRENCH]:t[WRENCH] + 6 * n].reshape((n, 6)),
+                   c_view(fb, t[IA], (n, 6, 6)),
+                   c_view(fb, t[PA], (n, 6)),
+                   c_view(fb, t[CB], (n, 6)),
+                   c_view(fb, t[U], (n, 6, 6)),
+                   c_view(fb, t[DL], (n, 6, 7)),
+                   c_view(fb, t[ACC], (n, 6)),
+                   c_view(fb, t[WRENCH], (n, 6)),
                    fb[t[LAM]:t[LAM] + nreact])
     return tree, body, state, loads, reactions, motion, jourdain, newton_euler, articulated
 
@@ -166,7 +202,7 @@ def state_derivative_packed(fb, ib, t, y, ydot):
     ud = jourdain[3]
     for k in range(nu):
         ydot[nq + k] = ud[k]
-    coordinate_rates(y[:nq], y[nq:], ib[t[SLOTS]:t[SLOTS] + 5 * t[8]].reshape((t[8], 5)),
+    coordinate_rates(y[:nq], y[nq:], c_view(ib, t[SLOTS], (t[8], 5)),
                      ydot[:nq])
     for k in range(ydot.shape[0]):
         if not np.isfinite(ydot[k]):
@@ -210,7 +246,7 @@ def state_derivative_articulated_packed(fb, ib, t, y, ydot):
     ud = fb[t[UD]:t[UD] + nu]
     for k in range(nu):
         ydot[nq + k] = ud[k]
-    coordinate_rates(y[:nq], y[nq:], ib[t[SLOTS]:t[SLOTS] + 5 * t[8]].reshape((t[8], 5)),
+    coordinate_rates(y[:nq], y[nq:], c_view(ib, t[SLOTS], (t[8], 5)),
                      ydot[:nq])
     for k in range(ydot.shape[0]):
         if not np.isfinite(ydot[k]):
