@@ -260,8 +260,11 @@ class Model:
         self._python_inputs = bool(self._driven or self._load_functions or self._laws)
         self._tree = (self._parent, self._kind, self._axis, self._seq, self._pos, self._C,
                       self._qoff, self._uoff, self._ucol, self._anc_ptr, self._anc_idx)
+        # no force elements: None instead of the empty table, so that the compiled
+        # kernels are specialised without them (kernels/evaluate.kinematics_and_loads)
         self._loads_arrays = (self._load_body, self._load_point, self._load_force,
-                              self._load_moment, self._load_in_body, self._force_int,
+                              self._load_moment, self._load_in_body,
+                              self._force_int if self._force_int.shape[0] else None,
                               self._force_data, self._switches)
         self._kin_out = (self._R, self._r, self._w, self._v, self._alpha, self._a,
                          self._JR, self._JT, self._F, self._N)
