@@ -64,6 +64,21 @@ def reaction_basis(joint):
     return basis
 
 
+def _lu_solve(A, b):
+    """``x`` of ``A x = b`` as numba's compiled ``np.linalg.solve`` gives it, bit for bit:
+    LAPACK's ``dgesv`` from scipy (the library numba calls); NaN or Inf in ``A`` or ``b``
+    and a singular ``A`` raise ``numpy.linalg.LinAlgError``, as there."""
+    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b))):
+        raise np.linalg.LinAlgError("Array must not contain infs or NaNs.")
+    if not b.shape[0]:
+        return b.copy()
+    from scipy.linalg.lapack import dgesv
+    _, _, x, info = dgesv(A, b)
+    if info > 0:
+        raise np.linalg.LinAlgError("Matrix is singular to machine precision.")
+    return x
+
+
 @dataclass(frozen=True)
 class Kinematics:
     """Motion of every frame (rows in ``Model.frames`` order).
@@ -686,12 +701,17 @@ class Model:
                     self._fill_inputs(q, u, t)
                 x, finite = kp.newton_euler_solution_packed(*self._packed, q, u)
             else:
-                self._fill(q, u, t)
-                x = ke.newton_euler_solution(
-                    *self._tree, self._mass, self._com, self._inertia, self.gravity,
-                    self._qfull, self._ufull, self._udfull, *self._loads_arrays,
-                    self._react_joint, self._react_force, self._react_moment,
-                    *self._kin_out, self._A, self._b)
+                # the steps of newton_euler_solution with kernels a run compiles anyway,
+                # and the LU solve from Python: no fused entry point of its own to compile
+                self._kinematics_kernel(q, u, t)
+                self._drop_velocity_products()
+                kd.newton_euler_system(self._mass, self._com, self._inertia, self._parent,
+                                       self._R, self._r, self._w, self._alpha, self._a,
+                                       self._JR, self._JT, self._anc_ptr, self._anc_idx,
+                                       self._F, self._N, self._react_joint,
+                                       self._react_force, self._react_moment, self._A,
+                                       self._b)
+                x = _lu_solve(self._A, self._b)
                 finite = bool(np.all(np.isfinite(x)))
         except np.linalg.LinAlgError:     # singular, or fed NaN/Inf: tell which
             self._jourdain_terms(q, u, t)
