@@ -40,7 +40,8 @@ def drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, an
     ufull[:] = 0.0
     forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                        qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT)
-    ufull[:] = saved
+    for k in range(ufull.shape[0]):     # element-wise: see kinematics.forward_kinematics
+        ufull[k] = saved[k]
 
 
 @njit(cache=True)

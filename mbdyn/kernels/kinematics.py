@@ -67,8 +67,13 @@ def forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_pt
             mat_mat(R[p], C[i], RJ0)
             mat_vec(R[p], pos[i], rho)
         else:
-            RJ0[:, :] = C[i]
-            rho[:] = pos[i]
+            # element by element: an array assignment (RJ0[:, :] = C[i]) makes numba compile
+            # its shape-mismatch error message, string formatting and all (seconds of a
+            # first run)
+            for k in range(3):
+                rho[k] = pos[i, k]
+                for m in range(3):
+                    RJ0[k, m] = C[i, k, m]
         mat_mat(RJ0, Rrel, R[i])
         mat_vec(RJ0, d, t1)
         for k in range(3):
