@@ -10,11 +10,12 @@ classic RK4; quaternions are projected back onto the unit sphere after every ste
 from __future__ import annotations
 
 import collections
+import collections.abc
 import time as _time
 import warnings
 
 import numpy as np
-from scipy import integrate, optimize
+import scipy                # its submodules load on first use (scipy.integrate: 0.2 s)
 
 from .balance import energy_balance
 from .events import Event, EventRecord, as_event, check_conditions
@@ -23,8 +24,25 @@ from . import limits
 from .errors import (ModelError, ModelWarning, NonFiniteError, SimulationError,
                      SingularityWarning, SingularMassMatrixError)
 
-ADAPTIVE = {"RK45": integrate.RK45, "RK23": integrate.RK23, "DOP853": integrate.DOP853,
-            "Radau": integrate.Radau, "BDF": integrate.BDF, "LSODA": integrate.LSODA}
+
+class _ScipySolvers(collections.abc.Mapping):
+    """scipy's ``OdeSolver`` classes by name, ``scipy.integrate`` imported on the first
+    look-up of a class (a fixed-step run does not need it)."""
+    NAMES = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+
+    def __getitem__(self, name):
+        if name not in self.NAMES:
+            raise KeyError(name)
+        return getattr(scipy.integrate, name)
+
+    def __iter__(self):
+        return iter(self.NAMES)
+
+    def __len__(self):
+        return len(self.NAMES)
+
+
+ADAPTIVE = _ScipySolvers()
 FIXED_STEP = ("euler", "semi-implicit-euler", "rk4", "implicit-midpoint")
 INTEGRATORS = tuple(ADAPTIVE) + FIXED_STEP
 OUTPUTS = ("reactions", "energy", "momentum")
@@ -632,7 +650,7 @@ def _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events, 
                     def g(tt, e=e):
                         yy = dense(tt)
                         return float(e.condition(tt, yy[:nq], yy[nq:]))
-                    te = optimize.brentq(g, t_prev, t_new, xtol=4 * np.finfo(float).eps,
+                    te = scipy.optimize.brentq(g, t_prev, t_new, xtol=4 * np.finfo(float).eps,
                                          rtol=4 * np.finfo(float).eps)
                     hits.append((te, e))
             for te, e in sorted(hits, key=lambda h: h[0]):

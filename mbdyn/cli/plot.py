@@ -8,13 +8,14 @@ from __future__ import annotations
 import os
 import sys
 
+from . import SUMMARIES
 from .common import Progress, add_model_arguments, load
 
 
 def register(subparsers):
     from ..viz import SERIES_HELP
     p = subparsers.add_parser(
-        "plot", help="plot a run's time series or a phase portrait",
+        "plot", help=SUMMARIES["plot"],
         description="Simulate the model with its [simulation] settings and plot series "
                     "against time (one axis per unit, events marked) or a phase portrait.")
     add_model_arguments(p)
