@@ -14,17 +14,48 @@ import numpy as np
 
 
 def _cumulative(t, p):
-    """Running integral of the samples ``p(t)`` (Simpson where scipy has it)."""
+    """Running integral of the samples ``p(t)``: Simpson's rule for three samples or more
+    at increasing times, else the trapezoidal rule."""
     if len(t) < 2:
         return np.zeros(len(t))
-    try:
-        from scipy.integrate import cumulative_simpson
-        if len(t) >= 3 and np.all(np.diff(t) > 0):
-            return cumulative_simpson(p, x=t, initial=0.0)
-    except ImportError:                  # scipy < 1.12
-        pass
+    if len(t) >= 3 and np.all(np.diff(t) > 0):
+        return cumulative_simpson(np.asarray(p, dtype=float), np.asarray(t, dtype=float))
     from scipy.integrate import cumulative_trapezoid
     return cumulative_trapezoid(p, x=t, initial=0.0)
+
+
+def _simpson_pieces(dx, y):
+    """The integral over each first interval ``[x_k, x_k+1]`` of the parabola through the
+    samples ``k, k+1, k+2`` (Cartwright's formula (8) for unequal intervals ``dx``)."""
+    x21 = dx[:-1]
+    x32 = dx[1:]
+    x31 = x21 + x32
+    x21_x31 = x21 / x31
+    x21_x32 = x21 / x32
+    x21x21_x31x32 = x21_x31 * x21_x32
+    coeff1 = 3 - x21_x31
+    coeff2 = 3 + x21x21_x31x32 + x21_x31
+    coeff3 = -x21x21_x31x32
+    return x21 / 6 * (coeff1 * y[:-2] + coeff2 * y[1:-1] + coeff3 * y[2:])
+
+
+def cumulative_simpson(y, x):
+    """``integral of y from x[0] to x[k]`` for every k (``len(x) >= 3``, increasing): each
+    interval by the parabola through it and its right neighbour, the last one through
+    its left neighbour.  The same operations as ``scipy.integrate.cumulative_simpson(y,
+    x=x, initial=0)`` (the same numbers, bit for bit; tests/test_balance.py), without
+    importing scipy.integrate (a fifth of a second of a run's start)."""
+    dx = np.diff(x)
+    first = _simpson_pieces(dx, y)                        # [x_k, x_k+1] from k, k+1, k+2
+    second = _simpson_pieces(dx[::-1], y[::-1])[::-1]     # [x_k+1, x_k+2] from k, k+1, k+2
+    pieces = np.empty(len(dx))
+    pieces[:-1:2] = first[::2]
+    pieces[1::2] = second[::2]
+    pieces[-1] = second[-1]
+    out = np.empty(len(y))
+    out[0] = 0.0
+    out[1:] = np.cumsum(pieces) + 0.0
+    return out
 
 
 def energy_balance(model, t, q, u):

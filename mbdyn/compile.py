@@ -71,6 +71,21 @@ def reaction_basis(joint):
     return basis
 
 
+def _lu_solve(A, b):
+    """``x`` of ``A x = b`` as numba's compiled ``np.linalg.solve`` gives it, bit for bit:
+    LAPACK's ``dgesv`` from scipy (the library numba calls); NaN or Inf in ``A`` or ``b``
+    and a singular ``A`` raise ``numpy.linalg.LinAlgError``, as there."""
+    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b))):
+        raise np.linalg.LinAlgError("Array must not contain infs or NaNs.")
+    if not b.shape[0]:
+        return b.copy()
+    from scipy.linalg.lapack import dgesv
+    _, _, x, info = dgesv(A, b)
+    if info > 0:
+        raise np.linalg.LinAlgError("Matrix is singular to machine precision.")
+    return x
+
+
 @dataclass(frozen=True)
 class Kinematics:
     """Motion of every frame (rows in ``Model.frames`` order).
@@ -278,8 +293,11 @@ class Model:
         self._python_inputs = bool(self._driven or self._load_functions or self._laws)
         self._tree = (self._parent, self._kind, self._axis, self._seq, self._pos, self._C,
                       self._qoff, self._uoff, self._ucol, self._anc_ptr, self._anc_idx)
+        # no force elements: None instead of the empty table, so that the compiled
+        # kernels are specialised without them (kernels/evaluate.kinematics_and_loads)
         self._loads_arrays = (self._load_body, self._load_point, self._load_force,
-                              self._load_moment, self._load_in_body, self._force_int,
+                              self._load_moment, self._load_in_body,
+                              self._force_int if self._force_int.shape[0] else None,
                               self._force_data, self._switches)
         self._kin_out = (self._R, self._r, self._w, self._v, self._alpha, self._a,
                          self._JR, self._JT, self._F, self._N)
@@ -722,7 +740,8 @@ class Model:
     def _newton_euler(self, q, u, t, dense=False):
         """The Newton-Euler unknowns ``[u', reactions]`` (a new array): eliminated in tree
         order (``kernels.articulated``), or, with ``dense``, the system of
-        ``kernels.dynamics.newton_euler_system`` solved by LU."""
+        ``kernels.dynamics.newton_euler_system`` solved by LU (from Python: it needs no
+        compiled entry point beyond the kinematics a run has compiled anyway)."""
         q, u = self._state(q, u)
         if not dense:
             if self._python_inputs:
@@ -735,9 +754,17 @@ class Model:
                 self._check_finite(q, u, t, x, "the Newton-Euler solution")
             return x
         try:
-            if self._python_inputs:
-                self._fill_inputs(q, u, t)
-            x, finite = kp.newton_euler_solution_packed(*self._packed, q, u)
+            # the steps of newton_euler_solution with kernels a run compiles anyway, and
+            # the LU solve from Python: no fused entry point of its own to compile
+            self._kinematics_kernel(q, u, t)
+            self._drop_velocity_products()
+            kd.newton_euler_system(self._mass, self._com, self._inertia, self._parent,
+                                   self._R, self._r, self._w, self._alpha, self._a,
+                                   self._JR, self._JT, self._anc_ptr, self._anc_idx,
+                                   self._F, self._N, self._react_joint,
+                                   self._react_force, self._react_moment, self._A, self._b)
+            x = _lu_solve(self._A, self._b)
+            finite = bool(np.all(np.isfinite(x)))
         except np.linalg.LinAlgError:     # singular, or fed NaN/Inf: tell which
             self._jourdain_terms(q, u, t)
             for out in (self._f, np.diag(self._M)):
@@ -793,7 +820,7 @@ class Model:
             out[name] = (force, moment)
         return out
 
-    def reactions(self, q, u, t=0.0, method="newton-euler", frame="world"):
+    def reactions(self, q, u, t=0.0, method="auto", frame="world"):
         """Force and moment each joint's parent exerts on its child, reduced to the joint
         origin (the child frame's origin): ``{joint: (F[3], M[3])}``, in world components
         (``frame="world"``) or in the child frame's own components (``frame="child"``, as
@@ -802,10 +829,14 @@ class Model:
         ``method="newton-euler"`` solves the system with reaction unknowns in tree order
         (``"newton-euler-dense"``: the dense 6n system); ``"jourdain"`` and
         ``"articulated"`` compute the accelerations by that route and then the joint
-        wrenches by inverse dynamics from the leaves to the root.
+        wrenches by inverse dynamics from the leaves to the root.  ``"auto"``: the dense
+        system below ``ARTICULATED_FROM`` speeds (it needs no compiled kernel beyond those
+        a run has, so a first run compiles less), tree order from there on.
         """
         if frame not in ("world", "child"):
             raise ModelError(f"unknown frame {frame!r} for reactions; use 'world' or 'child'")
+        if method == "auto":
+            method = "newton-euler-dense" if self.nu < ARTICULATED_FROM else "newton-euler"
         if method in ("newton-euler", "newton-euler-dense"):
             out = self.newton_euler(q, u, t, dense=method == "newton-euler-dense")[1]
         elif method in ("jourdain", "articulated"):

@@ -10,11 +10,12 @@ classic RK4; quaternions are projected back onto the unit sphere after every ste
 from __future__ import annotations
 
 import collections
+import collections.abc
 import time as _time
 import warnings
 
 import numpy as np
-from scipy import integrate, optimize
+import scipy                # its submodules load on first use (scipy.integrate: 0.2 s)
 
 from .balance import energy_balance
 from .events import Event, EventRecord, as_event, check_conditions
@@ -24,8 +25,25 @@ from .compile import METHODS as _METHODS
 from .errors import (ModelError, ModelWarning, NonFiniteError, SimulationError,
                      SingularityWarning, SingularMassMatrixError)
 
-ADAPTIVE = {"RK45": integrate.RK45, "RK23": integrate.RK23, "DOP853": integrate.DOP853,
-            "Radau": integrate.Radau, "BDF": integrate.BDF, "LSODA": integrate.LSODA}
+
+class _ScipySolvers(collections.abc.Mapping):
+    """scipy's ``OdeSolver`` classes by name, ``scipy.integrate`` imported on the first
+    look-up of a class (a fixed-step run does not need it)."""
+    NAMES = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+
+    def __getitem__(self, name):
+        if name not in self.NAMES:
+            raise KeyError(name)
+        return getattr(scipy.integrate, name)
+
+    def __iter__(self):
+        return iter(self.NAMES)
+
+    def __len__(self):
+        return len(self.NAMES)
+
+
+ADAPTIVE = _ScipySolvers()
 FIXED_STEP = ("euler", "semi-implicit-euler", "rk4", "implicit-midpoint")
 INTEGRATORS = tuple(ADAPTIVE) + FIXED_STEP
 OUTPUTS = ("reactions", "energy", "momentum")
@@ -140,7 +158,7 @@ class Result:
         return (f"<Result {self.model.name!r}: {len(self.t)} samples, t = {self.t[0]:g} .. "
                 f"{self.t[-1]:g}, events {self.events}>")
 
-    def compute_outputs(self, outputs=(), points=None, method="newton-euler", frame="world"):
+    def compute_outputs(self, outputs=(), points=None, method="auto", frame="world"):
         """Evaluate reactions (``frame``: ``"world"`` or ``"child"`` components), energies
         and point trajectories along the stored motion."""
         model = self.model
@@ -467,7 +485,7 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
         raise SimulationError(failure, result)
     result.stats["status"] = "ok"
     if outputs or points:
-        result.compute_outputs(outputs, points, method="newton-euler", frame=reactions_frame)
+        result.compute_outputs(outputs, points, frame=reactions_frame)
     return result
 
 
@@ -638,7 +656,7 @@ def _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events, 
                     def g(tt, e=e):
                         yy = dense(tt)
                         return float(e.condition(tt, yy[:nq], yy[nq:]))
-                    te = optimize.brentq(g, t_prev, t_new, xtol=4 * np.finfo(float).eps,
+                    te = scipy.optimize.brentq(g, t_prev, t_new, xtol=4 * np.finfo(float).eps,
                                          rtol=4 * np.finfo(float).eps)
                     hits.append((te, e))
             for te, e in sorted(hits, key=lambda h: h[0]):

@@ -57,3 +57,32 @@ def test_simulate_stays_the_function_after_its_module_is_imported():
     import mbdyn as mb
     import mbdyn.simulate  # noqa: F401  (binds the submodule on the package)
     assert callable(mb.simulate) and mb.simulate.__name__ == "simulate"
+
+
+RUN_PROBE = r"""
+import json, sys
+from mbdyn.cli import main
+code = main(["run", "models/top.toml", "--case", "a", "--t-end", "0.05", "--json"])
+compiled = sorted(f"{name}.{attr}" for name, mod in list(sys.modules.items())
+                  if name.startswith("mbdyn.kernels.")
+                  for attr, obj in vars(mod).items() if getattr(obj, "signatures", None))
+print(json.dumps({"code": code, "compiled": compiled, "modules": sorted(
+    m for m in ("mbdyn.symbolic", "mbdyn.analysis", "mbdyn.viz", "scipy.integrate",
+                "scipy.optimize", "matplotlib") if m in sys.modules)}))
+"""
+
+
+def test_a_fixed_step_run_loads_and_compiles_only_what_it_uses():
+    """``mbdyn run`` of the top (semi-implicit Euler, no force elements, reactions at the
+    output points) imports no other command's layers nor scipy's integrators, and neither
+    compiles nor loads the force-element kernel or the fused Newton-Euler solution."""
+    out = subprocess.run([sys.executable, "-c", RUN_PROBE], cwd=ROOT, capture_output=True,
+                         text=True, check=True)
+    got = json.loads(out.stdout.splitlines()[-1])
+    assert got["code"] == 0
+    assert got["modules"] == []
+    assert "mbdyn.kernels.integrators.semi_implicit_euler_loop" in got["compiled"]
+    for name in ("mbdyn.kernels.forces.force_elements",
+                 "mbdyn.kernels.evaluate.newton_euler_solution",
+                 "mbdyn.kernels.integrators.rk4_loop"):
+        assert name not in got["compiled"]

@@ -276,7 +276,7 @@ def run_member(task):
             return row
         if _needs_energy(qs) and len(result.t):
             try:
-                result.compute_outputs(("energy",), None, method="newton-euler")
+                result.compute_outputs(("energy",), None)
             except Exception:            # the failed state may not evaluate: keep NaN
                 pass
     except ModelError as exc:

@@ -3,7 +3,8 @@
 Each command is a submodule ``mbdyn.cli.NAME`` listed in ``COMMANDS`` with a
 ``register(subparsers)`` function that adds its parser and sets ``func`` (called with the
 parsed arguments, returns the exit code).  To add a command, write the module and append
-its name to ``COMMANDS``.
+its name to ``COMMANDS`` and its one-line help to ``SUMMARIES``.  Only the module of the
+command that runs is imported.
 
 Exit codes: 0 success; 1 a model file or input that cannot be used (one-line message on
 stderr); 2 a bad command line; 3 a simulation that failed (NaN, singularity, integrator
@@ -23,6 +24,22 @@ import warnings
 
 COMMANDS = ["run", "info", "eom", "accuracy", "equilibrium", "modes", "campbell", "plot",
             "animate", "sweep"]
+#: each command's one-line help, for ``mbdyn --help``: the parser lists every command from
+#: here and imports only the module of the command that runs (importing all of them would
+#: load sympy's printers, scipy and the analysis layer for any command)
+SUMMARIES = {
+    "run": "simulate a model file",
+    "info": "describe a model file",
+    "eom": "equations of motion in closed form",
+    "accuracy": "work-precision study: error, energy drift and cost of integrators",
+    "equilibrium": "static or steady equilibrium by Newton-Raphson",
+    "modes": "natural frequencies, damping ratios and mode shapes",
+    "campbell": "Campbell diagram: modes against a parameter (spin speed)",
+    "plot": "plot a run's time series or a phase portrait",
+    "animate": "animate a run: GIF, MP4 or a self-contained HTML view",
+    "sweep": "run a model file over a grid of overrides (parameters, initial state, "
+             "settings); one table row per member",
+}
 
 EXIT_OK, EXIT_INPUT, EXIT_USAGE, EXIT_SIMULATION, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 EXIT_TERMINATED, EXIT_BROKEN_PIPE = 143, 141
@@ -35,7 +52,10 @@ class ArgumentParser(argparse.ArgumentParser):
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
-def build_parser():
+def build_parser(command=None):
+    """The ``mbdyn`` parser.  With ``command`` (a name in ``COMMANDS``), only that command's
+    module is imported and its arguments added; the others are listed by their summary
+    (they are never parsed then).  Without, every command is complete."""
     from .. import __version__
     parser = ArgumentParser(
         prog="mbdyn",
@@ -44,8 +64,21 @@ def build_parser():
     parser.add_argument("--version", action="version", version=f"mbdyn {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=ArgumentParser)
     for name in COMMANDS:
-        importlib.import_module(f"{__name__}.{name}").register(sub)
+        if command is None or name == command:
+            importlib.import_module(f"{__name__}.{name}").register(sub)
+        else:
+            sub.add_parser(name, help=SUMMARIES[name])
     return parser
+
+
+def _command(argv):
+    """The command the command line names (its first word that is not an option; the
+    top-level parser takes no option values), or "" when it names none of ``COMMANDS``
+    (``--help``, ``--version``, a usage error: no command module is needed)."""
+    for word in argv:
+        if not word.startswith("-"):
+            return word if word in COMMANDS else ""
+    return ""
 
 
 def _one_line(text):
@@ -78,7 +111,8 @@ def _error(message):
 
 def main(argv=None):
     """Run the command line ``argv`` (default ``sys.argv[1:]``); returns the exit code."""
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser(_command(argv))
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:             # --help, --version, usage errors
@@ -166,4 +200,4 @@ def _dispatch(args, debug, ModelError, SimulationError):
             return 70
 
 
-__all__ = ["main", "COMMANDS", "build_parser"]
+__all__ = ["main", "COMMANDS", "SUMMARIES", "build_parser"]

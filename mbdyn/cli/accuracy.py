@@ -5,6 +5,7 @@ import json
 import math
 import sys
 
+from . import SUMMARIES
 from ..analysis.accuracy import DEFAULT_INTEGRATORS, TOLERANCES, accuracy_study
 from ..errors import ModelError
 from ..simulate import INTEGRATORS
@@ -13,7 +14,7 @@ from .common import add_model_arguments, load, positive, positive_int
 
 def register(subparsers):
     p = subparsers.add_parser(
-        "accuracy", help="work-precision study: error, energy drift and cost of integrators",
+        "accuracy", help=SUMMARIES["accuracy"],
         description="Integrate the model with a reference (DOP853 at 1e-13, cross-checked by "
                     "Radau), then with each integrator over a sweep of tolerances (adaptive) "
                     "or step sizes (fixed-step); report error (max over time), energy drift, "

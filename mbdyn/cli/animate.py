@@ -8,12 +8,13 @@ from __future__ import annotations
 import os
 import sys
 
+from . import SUMMARIES
 from .common import add_model_arguments, load, positive, Progress
 
 
 def register(subparsers):
     p = subparsers.add_parser(
-        "animate", help="animate a run: GIF, MP4 or a self-contained HTML view",
+        "animate", help=SUMMARIES["animate"],
         description="Simulate the model with its [simulation] settings and write an "
                     "animation: real-time playback (--speed to change), bodies with their "
                     "shapes, trails of the centres of mass, the time shown.  .html is one "

@@ -10,13 +10,14 @@ from __future__ import annotations
 import json
 import sys
 
+from . import SUMMARIES
 from .common import add_model_arguments, load
 from .vibration_args import add_vibration_arguments, names, value_range, whirl_pairs
 
 
 def register(subparsers):
     p = subparsers.add_parser(
-        "campbell", help="Campbell diagram: modes against a parameter (spin speed)",
+        "campbell", help=SUMMARIES["campbell"],
         description="Equilibrium, linearisation and modes at each value of a parameter; modes "
                     "tracked by shape (MAC); critical speeds and the onset of instability.")
     add_model_arguments(p)

@@ -18,6 +18,7 @@ from __future__ import annotations
 import json
 import sys
 
+from . import SUMMARIES
 from ..symbolic.derive import derive
 from ..symbolic.methods import METHODS
 from ..symbolic.simplify import MODES
@@ -29,7 +30,7 @@ FORMATS = ("text", "latex", "markdown", "json")
 def register(subparsers):
     from .common import add_model_arguments
     p = subparsers.add_parser(
-        "eom", help="equations of motion in closed form",
+        "eom", help=SUMMARIES["eom"],
         description="Derive a model's equations of motion with sympy by Newton-Euler (with "
                     "the joint reactions), Newton-Euler-Jourdain or Lagrange; print them, "
                     "optionally with the textbook's derivation steps and solved for the "

@@ -8,13 +8,14 @@ from __future__ import annotations
 import json
 import sys
 
+from . import SUMMARIES
 from .common import add_model_arguments, fmt, load
 from .vibration_args import add_vibration_arguments, names
 
 
 def register(subparsers):
     p = subparsers.add_parser(
-        "equilibrium", help="static or steady equilibrium by Newton-Raphson",
+        "equilibrium", help=SUMMARIES["equilibrium"],
         description="Find the configuration where the generalized forces vanish at the "
                     "initial speeds (zero unless the file gives spin speeds), starting from "
                     "the initial coordinates.")

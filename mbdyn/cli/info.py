@@ -8,13 +8,14 @@ import warnings
 
 import numpy as np
 
+from . import SUMMARIES
 from ..io.results import outputs_spec
 from .common import add_model_arguments, fmt, load
 
 
 def register(subparsers):
     p = subparsers.add_parser(
-        "info", help="describe a model file",
+        "info", help=SUMMARIES["info"],
         description="Describe a model file: bodies, joints, coordinates, speeds, degrees "
                     "of freedom, drives, loads, events and every validation warning.")
     add_model_arguments(p)

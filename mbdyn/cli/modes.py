@@ -9,13 +9,14 @@ from __future__ import annotations
 import json
 import sys
 
+from . import SUMMARIES
 from .common import add_model_arguments, load, positive, positive_int
 from .vibration_args import add_vibration_arguments, names, whirl_pairs
 
 
 def register(subparsers):
     p = subparsers.add_parser(
-        "modes", help="natural frequencies, damping ratios and mode shapes",
+        "modes", help=SUMMARIES["modes"],
         description="Linearise the model about its equilibrium (or its initial state) into "
                     "M x'' + (D + G) x' + (K + N) x = 0 and list its modes and stability.")
     add_model_arguments(p)

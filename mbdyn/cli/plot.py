@@ -8,13 +8,14 @@ from __future__ import annotations
 import os
 import sys
 
+from . import SUMMARIES
 from .common import Progress, add_model_arguments, load
 
 
 def register(subparsers):
     from ..viz import SERIES_HELP
     p = subparsers.add_parser(
-        "plot", help="plot a run's time series or a phase portrait",
+        "plot", help=SUMMARIES["plot"],
         description="Simulate the model with its [simulation] settings and plot series "
                     "against time (one axis per unit, events marked) or a phase portrait.")
     add_model_arguments(p)
@@ -43,7 +44,7 @@ def plot_run(scene, result, series=None, phase=None, out=None):
     need = [o for o in wanted_outputs(",".join(filter(None, [series, phase])))
             if getattr(result, o if o == "energy" else "reactions") is None]
     if need:
-        result.compute_outputs(tuple(need), method="newton-euler")
+        result.compute_outputs(tuple(need))
     path = out or os.path.splitext(os.path.basename(scene.path))[0] + (
         f"_{scene.case}" if scene.case else "") + ".png"
     result.plot(series=series, phase=phase, out=path,

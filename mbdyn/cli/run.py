@@ -5,6 +5,7 @@ import json
 import sys
 import warnings
 
+from . import SUMMARIES
 from .. import limits
 from ..errors import ModelWarning, SimulationError
 from ..io.loader import METHODS
@@ -22,7 +23,7 @@ FLAGS = (("simulation.t_end", "--t-end"), ("simulation.method", "--method"),
 
 def register(subparsers):
     p = subparsers.add_parser(
-        "run", help="simulate a model file",
+        "run", help=SUMMARIES["run"],
         description="Simulate a model file with its [simulation] settings; options "
                     "override them (after --case and --set).")
     add_model_arguments(p)

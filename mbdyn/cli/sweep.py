@@ -7,6 +7,7 @@ import json
 import math
 import sys
 
+from . import SUMMARIES
 from ..analysis.sweep import DEFAULT_QUANTITIES, parse_grid, sweep
 from ..errors import ModelError
 from ..io.schema import parse_set_value
@@ -15,8 +16,7 @@ from .common import fmt, positive_int
 
 def register(subparsers):
     p = subparsers.add_parser(
-        "sweep", help="run a model file over a grid of overrides (parameters, initial "
-                      "state, settings); one table row per member",
+        "sweep", help=SUMMARIES["sweep"],
         description="Run MODEL once per member of a grid of overrides by dotted path and "
                     "keep quantities of each run in a table (CSV).  Ranges: START:STOP:N "
                     "(N points, ends included), START:STOP:N:log, or a list [a, b, \"pi/4\"].")

@@ -281,7 +281,7 @@ class Scene:
                 raise
             raise ModelFileError(self.path, "simulation", str(exc)) from None
         if outputs or points:
-            result.compute_outputs(tuple(outputs), points or None, method="newton-euler")
+            result.compute_outputs(tuple(outputs), points or None)
         return result
 
 

@@ -33,8 +33,9 @@ def applied_loads(mass, com, gravity, R, r, load_body, load_point, load_force, l
             mat_vec(R[i], load_force[m], f)
             mat_vec(R[i], load_moment[m], mo)
         else:
-            f[:] = load_force[m]
-            mo[:] = load_moment[m]
+            for k in range(3):                       # (an array assignment would compile
+                f[k] = load_force[m, k]              # numba's shape-mismatch message)
+                mo[k] = load_moment[m, k]
         for k in range(3):
             arm[k] = load_point[m, k] - com[i, k]
         mat_vec(R[i], arm, lever)                    # centre of mass -> point of action
@@ -212,7 +213,9 @@ def _lapack_cholesky(M, L, tiny):
     for j in range(M.shape[0]):
         if not (Lf[j, j] * Lf[j, j] > tiny):
             return False
-    L[:, :] = Lf
+    for i in range(M.shape[0]):                 # element-wise: see kinematics.forward_kinematics
+        for j in range(M.shape[0]):
+            L[i, j] = Lf[i, j]
     return True
 
 

@@ -20,12 +20,13 @@ def kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_
                          force_int, force_data, switches,
                          R, r, w, v, alpha, a, JR, JT, F, N):
     """Motion of every frame, then the applied loads ``F``, ``N``: gravity, point loads
-    and force elements."""
+    and force elements.  ``force_int`` is None for a model without force elements: a type,
+    not a count, so that numba prunes the call and compiles no force kernel for it."""
     forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                        qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT)
     applied_loads(mass, com, gravity, R, r, load_body, load_point, load_force, load_moment,
                   load_in_body, F, N)
-    if force_int.shape[0]:
+    if force_int is not None and force_int.shape[0]:
         force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F,
                        N, force_data[0:0])
 
@@ -40,7 +41,8 @@ def drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, an
     ufull[:] = 0.0
     forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                        qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT)
-    ufull[:] = saved
+    for k in range(ufull.shape[0]):     # element-wise: see kinematics.forward_kinematics
+        ufull[k] = saved[k]
 
 
 @njit(cache=True)

@@ -282,7 +282,8 @@ def force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r,
 @njit(cache=True)
 def _to_world(i, R, s, out):
     if i < 0:
-        out[:] = s
+        for k in range(3):      # element-wise: an array assignment compiles numba's message
+            out[k] = s[k]
     else:
         mat_vec(R[i], s, out)
 
@@ -323,7 +324,8 @@ def _bushing_state(ia, ib, R, w, d, va, vb, x6, xd6, t1, t2, t3, t4):
     if ia >= 0:
         mat_t_vec(R[ia], t1, t2)
     else:
-        t2[:] = t1
+        for q in range(3):
+            t2[q] = t1[q]
     for q in range(3):
         xd6[3 + q] = t2[q]
 

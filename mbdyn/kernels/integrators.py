@@ -91,6 +91,14 @@ def _rhs(y, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body,
 
 
 @njit(cache=True, inline="always")
+def _copy(src, dst):
+    """``dst[:] = src`` element by element (an array assignment makes numba compile its
+    shape-mismatch message: string formatting, seconds of a first run)."""
+    for k in range(src.shape[0]):
+        dst[k] = src[k]
+
+
+@njit(cache=True, inline="always")
 def _normalize(y, quats):
     for s in range(quats.shape[0]):
         i = quats[s]
@@ -188,7 +196,7 @@ def _scratch(ny):
 def euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, drive_u,
                tree, body, loads, ws, out, nfev):
     """``fixed_step_loop`` with explicit Euler."""
-    out[0] = y0
+    _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
     for n in range(out.shape[0] - 1):
         st = euler_step(h, out[n], out[n + 1], drive_table[n], nq, slots, free_q, free_u,
@@ -203,7 +211,7 @@ def euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, dr
 def semi_implicit_euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q,
                              drive_u, tree, body, loads, ws, out, nfev):
     """``fixed_step_loop`` with semi-implicit Euler."""
-    out[0] = y0
+    _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
     for n in range(out.shape[0] - 1):
         st = semi_implicit_euler_step(h, out[n], out[n + 1], drive_table[n], nq, slots,
@@ -219,7 +227,7 @@ def semi_implicit_euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_
 def rk4_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, drive_u, tree,
              body, loads, ws, out, nfev):
     """``fixed_step_loop`` with RK4."""
-    out[0] = y0
+    _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
     for n in range(out.shape[0] - 1):
         st = rk4_step(h, out[n], out[n + 1], drive_table[n], nq, slots, free_q, free_u,
@@ -234,7 +242,7 @@ def rk4_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, driv
 def implicit_midpoint_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q,
                            drive_u, tree, body, loads, ws, out, nfev):
     """``fixed_step_loop`` with the implicit midpoint rule."""
-    out[0] = y0
+    _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
     for n in range(out.shape[0] - 1):
         st = midpoint_step(h, out[n], out[n + 1], drive_table[n], nq, slots, free_q, free_u,
@@ -261,7 +269,7 @@ def fixed_step_loop(scheme, h, y0, drive_table, nq, slots, quats, free_q, free_u
 
     The scheme is chosen at run time (for ``kernels.batched``), so this compiles all four
     steps; a single run calls its scheme's loop in ``LOOPS``, which does the same steps."""
-    out[0] = y0
+    _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
     for n in range(out.shape[0] - 1):
         y, yn, drives = out[n], out[n + 1], drive_table[n]

@@ -88,8 +88,8 @@ def forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_pt
                     Rp[k, m] = R[p, k, m]
             mat_mat(Rp, Ci, RJ0)
             mat_vec(Rp, posi, rho)
-        else:
-            for k in range(3):
+        else:                                 # (element by element: an array assignment
+            for k in range(3):                # makes numba compile its error message)
                 rho[k] = posi[k]
                 for m in range(3):
                     RJ0[k, m] = Ci[k, m]
