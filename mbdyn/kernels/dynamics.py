@@ -10,6 +10,7 @@ from numba import njit
 
 from .kinematics import cross
 from .linalg3 import cross_to, mat_vec, rotate_tensor
+from .views import c_view
 
 
 @njit(cache=True, inline="always")
@@ -83,15 +84,30 @@ def jourdain(mass, com, inertia, has_inertia, R, r, w, alpha_b, a_b, JR, JT, anc
     """Newton-Euler-Jourdain: ``M = sum JT^T m JT + JR^T I JR`` (assembled by the
     composite-rigid-body algorithm, ``composite_mass_matrix``) and
     ``f = sum JT^T (F - m a_bias) + JR^T (N - I alpha_bias - w x I w)``."""
-    composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc_idx, M)
-    nu = M.shape[0]
-    f[:] = 0.0
-    JG = np.zeros((3, nu))
-    Iw = np.empty((3, 3))
-    S3 = np.empty((3, 3))
-    tmp = np.empty(21)                  # the vector temporaries share one allocation
-    c, aG_b, gyro, t1 = tmp[0:3], tmp[3:6], tmp[6:9], tmp[9:12]
-    t2, fT, fR = tmp[12:15], tmp[15:18], tmp[18:21]
+    n, nu = mass.shape[0], M.shape[0]
+    _jourdain(mass, com, inertia, has_inertia, R, r, w, alpha_b, a_b, JR, JT, anc_ptr,
+              anc_idx, parent, F, N, M, f, np.empty(39 * n + 9 * nu + 60))
+
+
+@njit(cache=True)
+def _jourdain(mass, com, inertia, has_inertia, R, r, w, alpha_b, a_b, JR, JT, anc_ptr,
+              anc_idx, parent, F, N, M, f, work):
+    """``jourdain`` with its scratch in ``work`` (one allocation instead of ten; the views
+    are untracked, ``views.c_view``)."""
+    n, nu = mass.shape[0], M.shape[0]
+    composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc_idx, M,
+                          c_view(work, 0, (nu, 6)), c_view(work, 6 * nu, (n, 6, 6)),
+                          c_view(work, 6 * nu + 36 * n, (3 * n + 60,)))
+    at = 6 * nu + 39 * n + 60          # the mass matrix's scratch ends here
+    for k in range(nu):
+        f[k] = 0.0
+    JG = c_view(work, at, (3, nu))
+    for k in range(3 * nu):
+        work[at + k] = 0.0
+    Iw, S3 = c_view(work, 0, (3, 3)), c_view(work, 9, (3, 3))   # reuse: M is done
+    c, aG_b, gyro, t1 = (c_view(work, 18, (3,)), c_view(work, 21, (3,)),
+                         c_view(work, 24, (3,)), c_view(work, 27, (3,)))
+    t2, fT, fR = c_view(work, 30, (3,)), c_view(work, 33, (3,)), c_view(work, 36, (3,))
     for i in range(mass.shape[0]):
         if not has_inertia[i]:
             loaded = False
@@ -112,7 +128,8 @@ def jourdain(mass, com, inertia, has_inertia, R, r, w, alpha_b, a_b, JR, JT, anc
 
 
 @njit(cache=True, inline="always")
-def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc_idx, M):
+def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc_idx, M, S, IC,
+                          scratch):
     """``M`` by the composite-rigid-body algorithm, in world Pluecker coordinates.
 
     A speed's column is a twist ``S = (w, v0)``: angular velocity and the velocity of the
@@ -122,17 +139,20 @@ def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc
     composite inertias ``IC``, they give ``M[a, b] = S_a . IC_k S_b`` for every column b of
     frame k's joint and every column a of k's joint or an ancestor's -- O(n d^2) instead of
     the O(n nu^2) of summing ``J^T m J`` body by body.
+
+    Scratch: ``S`` (nu x 6), ``IC`` (n x 6 x 6) and ``scratch`` (at least 33 floats).
     """
     n = mass.shape[0]
     nu = M.shape[0]
-    S = np.empty((nu, 6))
-    IC = np.zeros((n, 6, 6))
-    Iw = np.empty((3, 3))
-    S3 = np.empty((3, 3))
-    tmp = np.empty(9)                   # the vector temporaries share one allocation
-    c, Fc = tmp[0:3], tmp[3:9]
-    M[:, :] = 0.0
-    o = np.empty(3)
+    for i in range(n):
+        for a_ in range(6):
+            for b_ in range(6):
+                IC[i, a_, b_] = 0.0
+    Iw, S3 = c_view(scratch, 0, (3, 3)), c_view(scratch, 9, (3, 3))
+    c, Fc, o = c_view(scratch, 18, (3,)), c_view(scratch, 21, (6,)), c_view(scratch, 27, (3,))
+    for a_ in range(nu):
+        for b_ in range(nu):
+            M[a_, b_] = 0.0
     for k in range(3):
         o[k] = r[0, k] if n else 0.0
     for i in range(n):

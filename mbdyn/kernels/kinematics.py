@@ -18,6 +18,7 @@ from numba import njit
 
 from .joints import MAX_NU, joint_motion
 from .linalg3 import cross_to, mat_mat, mat_vec
+from .views import c_view
 
 
 @njit(cache=True)
@@ -26,6 +27,10 @@ def cross(a, b):
     return np.array((a[1] * b[2] - a[2] * b[1],
                      a[2] * b[0] - a[0] * b[2],
                      a[0] * b[1] - a[1] * b[0]))
+
+
+#: floats of scratch ``forward_kinematics`` needs (see ``_walk``)
+KINEMATICS_WORK = 5 * 9 + 2 * 3 * MAX_NU + 4 * 9 + 8 * 3 + 25 * 3 + 1
 
 
 @njit(cache=True)
@@ -37,28 +42,36 @@ def forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_pt
     depends (its own joint's and its ancestors'); the other columns of ``JR[i]`` and
     ``JT[i]`` are zero and are never written, so the caller zeroes them once.
     """
+    _walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull, ufull,
+          udfull, R, r, w, v, alpha, a, JR, JT, np.empty(KINEMATICS_WORK),
+          np.empty(3, np.int64))
+
+
+@njit(cache=True)
+def _walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull, ufull,
+          udfull, R, r, w, v, alpha, a, JR, JT, work, seqi):
+    """``forward_kinematics`` with its scratch ``work`` (``KINEMATICS_WORK`` floats, one
+    allocation instead of a dozen) and ``seqi`` (3 integers)."""
     n = parent.shape[0]
     # Per-frame rows are copied into this scratch, element by element, rather than passed
-    # on as views (R[p], w[p], ...): in a loop this long numba cannot prune a view's two
-    # reference-count calls, and those cost more than the arithmetic of a small model.
-    Rrel = np.empty((3, 3))
-    RJ0 = np.empty((3, 3))
-    Rp = np.empty((3, 3))
-    Ri = np.empty((3, 3))
-    Ci = np.empty((3, 3))
-    Hw = np.empty((3, MAX_NU))
-    Hv = np.empty((3, MAX_NU))
-    Sm = np.empty((4, 3, 3))
-    Sv = np.empty((8, 3))
-    seqi = np.empty(3, np.int64)
-    # the vector temporaries share one allocation (each np.empty costs about 40 ns)
-    tmp = np.empty(19 * 3 + 7 + 6 + 6)
-    d, hw, hv, rho = tmp[0:3], tmp[3:6], tmp[6:9], tmp[9:12]
-    wrel_b, dwrel_b, vrel_j, dvrel_j = tmp[12:15], tmp[15:18], tmp[18:21], tmp[21:24]
-    wrel, vrel, t1, t2 = tmp[24:27], tmp[27:30], tmp[30:33], tmp[33:36]
-    t3, t4, axi, posi = tmp[36:39], tmp[39:42], tmp[42:45], tmp[45:48]
-    wp, alp, wrk = tmp[48:51], tmp[51:54], tmp[54:57]
-    qj, uj, udj = tmp[57:64], tmp[64:70], tmp[70:76]
+    # on as views (R[p], w[p], ...): each view costs reference-count calls, which cost
+    # more than the arithmetic of a small model; the scratch views (c_view) cost none.
+    Rrel, RJ0, Rp = c_view(work, 0, (3, 3)), c_view(work, 9, (3, 3)), c_view(work, 18, (3, 3))
+    Ri, Ci = c_view(work, 27, (3, 3)), c_view(work, 36, (3, 3))
+    Hw, Hv = c_view(work, 45, (3, MAX_NU)), c_view(work, 45 + 3 * MAX_NU, (3, MAX_NU))
+    at = 45 + 6 * MAX_NU
+    Sm, Sv = c_view(work, at, (4, 3, 3)), c_view(work, at + 36, (8, 3))
+    at += 60
+    d, hw, hv, rho = (c_view(work, at, (3,)), c_view(work, at + 3, (3,)),
+                      c_view(work, at + 6, (3,)), c_view(work, at + 9, (3,)))
+    wrel_b, dwrel_b, vrel_j, dvrel_j = (c_view(work, at + 12, (3,)), c_view(work, at + 15, (3,)),
+                                        c_view(work, at + 18, (3,)), c_view(work, at + 21, (3,)))
+    wrel, vrel, t1, t2 = (c_view(work, at + 24, (3,)), c_view(work, at + 27, (3,)),
+                          c_view(work, at + 30, (3,)), c_view(work, at + 33, (3,)))
+    t3, t4, axi, posi = (c_view(work, at + 36, (3,)), c_view(work, at + 39, (3,)),
+                         c_view(work, at + 42, (3,)), c_view(work, at + 45, (3,)))
+    wp, alp = c_view(work, at + 48, (3,)), c_view(work, at + 51, (3,))
+    qj, uj, udj = c_view(work, at + 54, (7,)), c_view(work, at + 61, (6,)), c_view(work, at + 67, (6,))
     for i in range(n):
         p = parent[i]
         k0 = qoff[i]

@@ -13,16 +13,13 @@ state (what ``Model._fill`` does in Python for the other evaluations); drives an
 given as Python functions are still written by the caller first.
 """
 import numpy as np
-from numba import njit, types
-from numba.core import cgutils
-from numba.core.imputils import impl_ret_untracked
-from numba.extending import intrinsic
-from numba.np.arrayobj import make_array, populate_array
+from numba import njit
 
 from .evaluate import (articulated_accelerations, jourdain_accelerations, newton_euler_solution,
                        newton_euler_tree)
 from .forces import ROW
 from .joints import coordinate_rates
+from .views import c_view
 
 #: float arrays in buffer order, with their shapes in terms of the sizes below
 FLOATS = ("gravity", "axis", "pos", "C", "mass", "com", "inertia", "load_point", "load_force",
@@ -44,38 +41,6 @@ SIZES = ("n", "nu", "nl", "nqf", "nuf", "nanc", "nreact", "nq", "nslots", "ne", 
                                                                 len(SIZES) + len(FLOATS))
 (PARENT, KIND, SEQ, QOFF, UOFF, UCOL, ANC_PTR, ANC_IDX, HAS_INERTIA, LOAD_BODY, LOAD_IN_BODY,
  REACT_JOINT, FREE_Q, FREE_U, SLOTS, FORCE_INT, SWITCHES, OWN_PTR, OWN_IDX) = range(len(SIZES) + len(FLOATS), len(SIZES) + len(FLOATS) + len(INTS))
-
-
-@intrinsic
-def c_view(typingctx, buf, start, shape):
-    """``buf[start:start + prod(shape)].reshape(shape)`` for a 1-d C-contiguous ``buf``,
-    built directly (numba's ``reshape`` calls a C helper, about 25 ns: a tenth of a small
-    model's evaluation over the 60 views of ``_views``).  No bounds check: the offsets
-    come from ``pack``.  The view shares ``buf``'s memory but holds no reference to it
-    (no reference counting either, which costs as much again): it must not outlive the
-    call that made it -- the packed kernels only use their views inside."""
-    if not (isinstance(buf, types.Array) and buf.ndim == 1 and buf.layout == "C"
-            and isinstance(shape, types.UniTuple) and isinstance(start, types.Integer)):
-        return None
-    ndim = shape.count
-    view_type = types.Array(buf.dtype, ndim, "C")
-
-    def codegen(context, builder, sig, args):
-        src = make_array(sig.args[0])(context, builder, args[0])
-        shapes = cgutils.unpack_tuple(builder, args[2], ndim)
-        strides = [None] * ndim
-        stride = src.itemsize
-        for k in range(ndim - 1, -1, -1):           # C order
-            strides[k] = stride
-            stride = builder.mul(stride, shapes[k])
-        first = context.cast(builder, args[1], sig.args[1], types.intp)
-        out = make_array(view_type)(context, builder)
-        null = cgutils.get_null_value(src.meminfo.type)
-        populate_array(out, data=builder.gep(src.data, [first]), shape=shapes,
-                       strides=strides, itemsize=src.itemsize, meminfo=null,
-                       parent=cgutils.get_null_value(src.parent.type))
-        return impl_ret_untracked(context, builder, view_type, out._getvalue())
-    return view_type(buf, start, shape), codegen
 
 
 def pack(floats, ints):
