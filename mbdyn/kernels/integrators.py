@@ -20,6 +20,7 @@ from numba.extending import overload
 
 from .evaluate import articulated_accelerations, jourdain_accelerations
 from .joints import coordinate_rates
+from .views import untracked
 
 EULER, SEMI_IMPLICIT_EULER, RK4, IMPLICIT_MIDPOINT = 0, 1, 2, 3
 SCHEMES = {"euler": EULER, "semi-implicit-euler": SEMI_IMPLICIT_EULER, "rk4": RK4,
@@ -198,6 +199,8 @@ def euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, dr
     """``fixed_step_loop`` with explicit Euler."""
     _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
+    tree, body, loads, ws = untracked(tree), untracked(body), untracked(loads), untracked(ws)
+    out, drive_table = untracked(out), untracked(drive_table)
     for n in range(out.shape[0] - 1):
         st = euler_step(h, out[n], out[n + 1], drive_table[n], nq, slots, free_q, free_u,
                         drive_q, drive_u, tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
@@ -213,6 +216,8 @@ def semi_implicit_euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_
     """``fixed_step_loop`` with semi-implicit Euler."""
     _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
+    tree, body, loads, ws = untracked(tree), untracked(body), untracked(loads), untracked(ws)
+    out, drive_table = untracked(out), untracked(drive_table)
     for n in range(out.shape[0] - 1):
         st = semi_implicit_euler_step(h, out[n], out[n + 1], drive_table[n], nq, slots,
                                       free_q, free_u, drive_q, drive_u, tree, body, loads, ws,
@@ -229,6 +234,8 @@ def rk4_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, driv
     """``fixed_step_loop`` with RK4."""
     _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
+    tree, body, loads, ws = untracked(tree), untracked(body), untracked(loads), untracked(ws)
+    out, drive_table = untracked(out), untracked(drive_table)
     for n in range(out.shape[0] - 1):
         st = rk4_step(h, out[n], out[n + 1], drive_table[n], nq, slots, free_q, free_u,
                       drive_q, drive_u, tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
@@ -244,6 +251,8 @@ def implicit_midpoint_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u,
     """``fixed_step_loop`` with the implicit midpoint rule."""
     _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
+    tree, body, loads, ws = untracked(tree), untracked(body), untracked(loads), untracked(ws)
+    out, drive_table = untracked(out), untracked(drive_table)
     for n in range(out.shape[0] - 1):
         st = midpoint_step(h, out[n], out[n + 1], drive_table[n], nq, slots, free_q, free_u,
                            drive_q, drive_u, tree, body, loads, ws, k1, k2, k3, k4, tmp, J,
@@ -271,6 +280,8 @@ def fixed_step_loop(scheme, h, y0, drive_table, nq, slots, quats, free_q, free_u
     steps; a single run calls its scheme's loop in ``LOOPS``, which does the same steps."""
     _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
+    tree, body, loads, ws = untracked(tree), untracked(body), untracked(loads), untracked(ws)
+    out, drive_table = untracked(out), untracked(drive_table)
     for n in range(out.shape[0] - 1):
         y, yn, drives = out[n], out[n + 1], drive_table[n]
         if scheme == EULER:

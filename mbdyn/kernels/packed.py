@@ -19,7 +19,7 @@ from .evaluate import (articulated_accelerations, jourdain_accelerations, newton
                        newton_euler_tree)
 from .forces import ROW
 from .joints import coordinate_rates
-from .views import c_view
+from .views import c_view, untracked
 
 #: float arrays in buffer order, with their shapes in terms of the sizes below
 FLOATS = ("gravity", "axis", "pos", "C", "mass", "com", "inertia", "load_point", "load_force",
@@ -86,6 +86,7 @@ def _views(fb, ib, t):
     Offsets are read from ``t`` at run time: literal constants as arguments would make
     numba compile a slicing helper per constant."""
     n, nu, nl, nqf, nuf, nanc, nreact = t[0], t[1], t[2], t[3], t[4], t[5], t[6]
+    fb, ib = untracked(fb), untracked(ib)       # slices of them are untracked too
     tree = (ib[t[PARENT]:t[PARENT] + n], ib[t[KIND]:t[KIND] + n],
             c_view(fb, t[AXIS], (n, 3)),
             c_view(ib, t[SEQ], (n, 3)),

@@ -44,3 +44,34 @@ def c_view(typingctx, buf, start, shape):
                        parent=cgutils.get_null_value(src.parent.type))
         return impl_ret_untracked(context, builder, view_type, out._getvalue())
     return view_type(buf, start, shape), codegen
+
+
+def _untracked_value(context, builder, typ, value):
+    """``value`` of numba type ``typ`` with its array structures' reference-count handle
+    (meminfo) and parent cleared; other values unchanged; tuples member by member."""
+    if isinstance(typ, types.Array):
+        arr = make_array(typ)(context, builder, value)
+        out = make_array(typ)(context, builder)
+        populate_array(out, data=arr.data, shape=cgutils.unpack_tuple(builder, arr.shape),
+                       strides=cgutils.unpack_tuple(builder, arr.strides),
+                       itemsize=arr.itemsize,
+                       meminfo=cgutils.get_null_value(arr.meminfo.type),
+                       parent=cgutils.get_null_value(arr.parent.type))
+        return out._getvalue()
+    if isinstance(typ, types.BaseTuple):
+        members = [_untracked_value(context, builder, t, builder.extract_value(value, k))
+                   for k, t in enumerate(typ)]
+        return context.make_tuple(builder, typ, members)
+    return value
+
+
+@intrinsic
+def untracked(typingctx, value):
+    """The same array (or tuple of arrays, nested; other members as they are) without
+    reference counting: the views a kernel then takes of it cost no reference-count
+    calls.  As with ``c_view``, use it only on a function's arguments, inside that
+    function (they stay alive for the whole call)."""
+    def codegen(context, builder, sig, args):
+        return impl_ret_untracked(context, builder, sig.return_type,
+                                  _untracked_value(context, builder, sig.args[0], args[0]))
+    return value(value), codegen
