@@ -556,8 +556,10 @@ def print_report(report):
     print("| measure | mbdyn | peer | ratio | goal | met |")
     print("|---|---:|---|---:|---:|---|")
     for r in report["rows"]:
-        peer_txt = (f"{r['peer_name']}: {fmt(r['peer'], r['unit'])}" if r["peer"] is not None
-                    else r["peer_name"] or "skipped")
+        if r["peer_name"].startswith("(no peer"):
+            peer_txt = r["peer_name"]
+        else:
+            peer_txt = f"{r['peer_name']}: {fmt(r['peer'], r['unit'])}"
         ratio = "" if r["ratio"] is None else f"{r['ratio']:.2f}"
         if r["goal"] is None:
             goal = ""
@@ -634,7 +636,8 @@ def main(argv=None):
         versions[name] = getattr(mod, "__version__", "?") if mod else "not loaded"
     src = fdb.source_info(mb)
     report = {"source": src["path"],
-              "commit": f"{src['commit']}{' + uncommitted changes' if src['modified'] else ''}",
+              "commit": (f"{src['commit']}{' + uncommitted changes' if src['modified'] else ''}"
+                         if src["commit"] else "not a git checkout"),
               "peers": versions,
               "settings": {"quick": args.quick, "rounds": rounds, "budget_s": budget,
                            "repeats": repeats, "only": sorted(which)},
