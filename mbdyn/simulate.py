@@ -737,6 +737,10 @@ def _run_adaptive_compiled(rhs, integrator, t0, t_end, y0, rtol, atol, max_step,
     nq, n = model.nq, y0.size
     tab = TABLEAUS[integrator]
     kind, A, B, E, E3, D = tab.arrays()
+    if rtol < 100 * np.finfo(float).eps:        # as scipy's solvers do
+        warnings.warn("At least one element of `rtol` is too small. Setting "
+                      f"`rtol = np.maximum(rtol, {100 * np.finfo(float).eps})`.", stacklevel=3)
+        rtol = 100 * np.finfo(float).eps
 
     def derivative(t, y):
         rhs.evaluations += 1

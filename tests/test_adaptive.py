@@ -277,3 +277,13 @@ def test_scipy_names_are_valid_in_model_files(tmp_path):
     res = load_model(path).simulate(t_end=0.1)
     assert res.stats["integrator"] == "scipy-RK45" and not res.stats["compiled"]
     assert "scipy-DOP853" in mb.INTEGRATORS
+
+
+def test_a_tolerance_below_roundoff_is_raised_as_scipy_does(pendulum):
+    for integrator in PAIRS:
+        with pytest.warns(UserWarning, match="rtol` is too small"):
+            a = mb.simulate(pendulum, 0.02, P0, integrator=integrator, rtol=1e-17)
+        with pytest.warns(UserWarning, match="rtol` is too small"):
+            b = mb.simulate(pendulum, 0.02, P0, integrator="scipy-" + integrator, rtol=1e-17)
+        assert abs(a.stats["steps"] - b.stats["steps"]) <= max(2, 0.03 * b.stats["steps"])
+        assert np.allclose(a.q[-1], b.q[-1], atol=1e-12)
