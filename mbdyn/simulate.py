@@ -726,13 +726,86 @@ def _crossed_rows(e, g_old, g_new):
     return up if e.direction > 0 else down if e.direction < 0 else up | down
 
 
+def _stretch_events(events, model, g_old, t_start, y_start, T, Y, H, out_K, tab, dense_args,
+                    nfev):
+    """The events of a stretch of accepted steps ``(T, Y, H)`` after ``(t_start, y_start)``
+    (conditions ``g_old`` there): ``(G, ends, found)`` -- the conditions at every row, the
+    rows where the stretch ends (``(row, 1, "event")`` at a non-finite condition,
+    ``(row, 2, "terminal", t_event, state_at)``) and ``{row: [EventRecord, ...]}``, each
+    crossing located by brentq on the step's dense polynomial."""
+    from .kernels.adaptive import dense_step, dense_values
+    nq = model.nq
+    ends, found = [], {}
+    G = _event_rows(events, model, T, Y)
+    bad = np.flatnonzero(~np.all(np.isfinite(G), axis=1))
+    if bad.size:
+        ends.append((int(bad[0]), 1, "event"))
+    last = int(bad[0]) if bad.size else len(T)
+    before = np.vstack([g_old[None, :], G[:-1]])
+    crossing = np.zeros(G.shape, bool)
+    for k, e in enumerate(events):
+        crossing[:last, k] = _crossed_rows(e, before[:last, k], G[:last, k])
+    for r in np.flatnonzero(crossing.any(axis=1)):
+        t_old = T[r - 1] if r else t_start
+        y_old = Y[r - 1] if r else y_start
+        F, st = dense_step(tab.A, tab.D, tab.stages, y_old, Y[r], H[r], out_K[r], *dense_args,
+                           nfev)
+        if st:          # not expected: the stages of an accepted step were finite
+            raise NonFiniteError("the dense output of a step became non-finite")
+
+        def state_at(tt, F=F, y_old=y_old, t_old=t_old, h=H[r]):
+            return dense_values(F, y_old, (tt - t_old) / h)[0]
+        hits = []
+        for k, e in enumerate(events):
+            if crossing[r, k]:
+                def g(tt, e=e):
+                    yy = state_at(tt)
+                    return float(e.condition(tt, yy[:nq], yy[nq:]))
+                te = optimize.brentq(g, t_old, T[r], xtol=4 * np.finfo(float).eps,
+                                     rtol=4 * np.finfo(float).eps)
+                hits.append((te, e))
+        records = found[int(r)] = []
+        for te, e in sorted(hits, key=lambda h: h[0]):
+            ye = state_at(te)
+            records.append(EventRecord(e.name, te, ye[:nq], ye[nq:],
+                                       model.coordinates + model.speeds))
+            if e.terminal:
+                ends.append((int(r), 2, "terminal", te, state_at))
+                return G, ends, found
+    return G, ends, found
+
+
+def _stretch_budget_ends(budget, steps, kept, T, H, t_end, recent):
+    """The first row of a stretch after which a budget is used up, as on scipy's path
+    (checked after every step that did not finish the run): ``[(row, 3 or 4, "budget",
+    message)]`` or ``[]``.  ``steps`` were taken before the stretch; ``kept[r]`` samples
+    are stored after row ``r``; ``recent``: the step sizes before the stretch."""
+    ends = []
+    going = T < t_end
+    counts = steps + 1 + np.arange(len(T))
+    over = np.flatnonzero(going & ((counts >= budget["max_steps"])
+                                   | (kept > budget["max_samples"])))
+    if over.size:
+        r = int(over[0])
+        ends.append((r, 3, "budget", _over_budget(budget, int(counts[r]), int(kept[r]), T[r],
+                                                  t_end, h=H[r])))
+    history = np.concatenate([recent, H])
+    for r in np.flatnonzero(going & (counts % PROJECTION_STEPS == 0)):
+        tail = history[:len(recent) + r + 1][-PROJECTION_STEPS:]
+        message = _projected_over_budget(budget, int(counts[r]), T[r], t_end, tail)
+        if message:
+            ends.append((int(r), 4, "budget", message))
+            break
+    return ends
+
+
 def _run_adaptive_compiled(rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events,
                            t_eval, progress, monitor, budget):
     """RK45 or DOP853 as compiled stretches of accepted steps (``kernels.adaptive``): the
     same steps as scipy's solvers; after each stretch, in Python and on whole arrays: the
     singularity monitor, the events (crossings located by brentq on the compiled dense
     output), the budgets, progress.  Output times are sampled inside the stretch."""
-    from .kernels.adaptive import TABLEAUS, dense_step, dense_values, initial_step, rk_stretch
+    from .kernels.adaptive import TABLEAUS, initial_step, rk_stretch
     model = rhs.model
     nq, n = model.nq, y0.size
     tab = TABLEAUS[integrator]
@@ -796,66 +869,13 @@ def _run_adaptive_compiled(rhs, integrator, t0, t_end, y0, rtol, atol, max_step,
         T, Y, H = out_t[:acc], out_y[:acc], out_h[:acc]
         # where this stretch ends: (row, reason) in the order a step is examined --
         # singularity monitor, events, budgets
-        ends = []
-        G = None
-        hits_by_row = {}
+        ends, G, hits_by_row = [], None, {}
         if events and acc:
-            G = _event_rows(events, model, T, Y)
-            bad = np.flatnonzero(~np.all(np.isfinite(G), axis=1))
-            if bad.size:
-                ends.append((int(bad[0]), 1, "event"))
-            last = int(bad[0]) if bad.size else acc
-            before = np.vstack([g_old[None, :], G[:-1]])
-            crossing = np.zeros((acc, len(events)), bool)
-            for k, e in enumerate(events):
-                crossing[:last, k] = _crossed_rows(e, before[:last, k], G[:last, k])
-            for r in np.flatnonzero(crossing.any(axis=1)):
-                t_old = T[r - 1] if r else t_start
-                y_old = Y[r - 1] if r else y_start
-                F, st = dense_step(A, D, tab.stages, y_old, Y[r], H[r], out_K[r],
-                                   *dense_args, nfev)
-                if st:          # not expected: the stages of an accepted step were finite
-                    raise NonFiniteError("the dense output of a step became non-finite")
-
-                def state_at(tt, F=F, y_old=y_old, t_old=t_old, h=H[r]):
-                    return dense_values(F, y_old, (tt - t_old) / h)[0]
-                hits = []
-                for k, e in enumerate(events):
-                    if crossing[r, k]:
-                        def g(tt, e=e):
-                            yy = state_at(tt)
-                            return float(e.condition(tt, yy[:nq], yy[nq:]))
-                        te = optimize.brentq(g, t_old, T[r], xtol=4 * np.finfo(float).eps,
-                                             rtol=4 * np.finfo(float).eps)
-                        hits.append((te, e))
-                rows = []
-                for te, e in sorted(hits, key=lambda h: h[0]):
-                    ye = state_at(te)
-                    rows.append(EventRecord(e.name, te, ye[:nq], ye[nq:],
-                                            model.coordinates + model.speeds))
-                    if e.terminal:
-                        ends.append((int(r), 2, "terminal", te, state_at))
-                        break
-                hits_by_row[int(r)] = rows
-                if ends and ends[-1][2] == "terminal":
-                    break
-        # budgets after each step that did not finish the run
-        going = T < t_end
-        counts = steps + 1 + np.arange(acc)
+            G, ends, hits_by_row = _stretch_events(events, model, g_old, t_start, y_start,
+                                                   T, Y, H, out_K, tab, dense_args, nfev)
         kept = (stored + 1 + np.arange(acc)) if t_eval is None else out_ieval[:acc]
-        over = np.flatnonzero(going & ((counts >= budget["max_steps"])
-                                       | (kept > budget["max_samples"])))
-        if over.size:
-            r = int(over[0])
-            ends.append((r, 3, "budget", _over_budget(budget, int(counts[r]), int(kept[r]),
-                                                      T[r], t_end, h=H[r])))
+        ends += _stretch_budget_ends(budget, steps, kept, T, H, t_end, recent)
         history = np.concatenate([recent, H])
-        for r in np.flatnonzero(going & (counts % PROJECTION_STEPS == 0)):
-            tail = history[:len(recent) + r + 1][-PROJECTION_STEPS:]
-            message = _projected_over_budget(budget, int(counts[r]), T[r], t_end, tail)
-            if message:
-                ends.append((int(r), 4, "budget", message))
-                break
         end = min(ends, key=lambda x: (x[0], x[1])) if ends else None
         upto = end[0] + 1 if end else acc
         n_ok, monitor_failure = monitor.check_rows(T[:upto], Y[:upto])
