@@ -287,3 +287,11 @@ def test_a_tolerance_below_roundoff_is_raised_as_scipy_does(pendulum):
             b = mb.simulate(pendulum, 0.02, P0, integrator="scipy-" + integrator, rtol=1e-17)
         assert abs(a.stats["steps"] - b.stats["steps"]) <= max(2, 0.03 * b.stats["steps"])
         assert np.allclose(a.q[-1], b.q[-1], atol=1e-12)
+
+
+def test_scipy_names_on_the_command_line(capsys):
+    from mbdyn.cli import main
+    path = str(MODELS / "mass_spring_damper.toml")
+    for name in ("scipy-DOP853", "scipy-RK45", "RK45"):
+        assert main(["run", path, "--t-end", "0.05", "--integrator", name]) == 0
+        assert f"integrator {name}," in capsys.readouterr().out
