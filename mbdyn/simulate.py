@@ -436,12 +436,19 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     budget["deadline"] = (None if budget["max_wall_time"] is None
                           else start + budget["max_wall_time"])
     if integrator in ADAPTIVE:
-        compiled = (compiled_loop and integrator in COMPILED_ADAPTIVE and method == "jourdain"
-                    and not model.has_callable_loads and not model.driven_joints
-                    and y0.size > 0)
-        run = _run_adaptive_compiled if compiled else _run_adaptive
-        ts, ys, found, info = run(rhs, integrator, t0, t_end, y0, rtol, atol, max_step,
-                                  events, t_eval, progress, monitor, budget)
+        programs = None
+        if (compiled_loop and integrator in COMPILED_ADAPTIVE and method == "jourdain"
+                and not model.has_callable_loads and y0.size > 0):
+            from .programs import drive_programs
+            programs = drive_programs([d[3] for d in model._driven])
+        if programs is not None:
+            ts, ys, found, info = _run_adaptive_compiled(
+                rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events, t_eval,
+                progress, monitor, budget, programs)
+        else:
+            ts, ys, found, info = _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol,
+                                                max_step, events, t_eval, progress, monitor,
+                                                budget)
     else:
         compiled = compiled_loop and method == "jourdain" and not model.has_callable_loads
         ts, ys, found, info = _run_fixed(rhs, integrator, t0, t_end, y0, float(dt), events,
@@ -729,7 +736,8 @@ def _crossed_rows(e, g_old, g_new):
 def _stretch_events(events, model, g_old, t_start, y_start, T, Y, H, out_K, tab, dense_args,
                     nfev):
     """The events of a stretch of accepted steps ``(T, Y, H)`` after ``(t_start, y_start)``
-    (conditions ``g_old`` there): ``(G, ends, found)`` -- the conditions at every row, the
+    (conditions ``g_old`` there; ``dense_args``: the drive programs and the model's arrays
+    after ``dense_step``'s first ones): ``(G, ends, found)`` -- the conditions at every row, the
     rows where the stretch ends (``(row, 1, "event")`` at a non-finite condition,
     ``(row, 2, "terminal", t_event, state_at)``) and ``{row: [EventRecord, ...]}``, each
     crossing located by brentq on the step's dense polynomial."""
@@ -748,8 +756,8 @@ def _stretch_events(events, model, g_old, t_start, y_start, T, Y, H, out_K, tab,
     for r in np.flatnonzero(crossing.any(axis=1)):
         t_old = T[r - 1] if r else t_start
         y_old = Y[r - 1] if r else y_start
-        F, st = dense_step(tab.A, tab.D, tab.stages, y_old, Y[r], H[r], out_K[r], *dense_args,
-                           nfev)
+        F, st = dense_step(tab.A, tab.C, tab.D, tab.stages, t_old, y_old, Y[r], H[r], out_K[r],
+                           *dense_args, nfev)
         if st:          # not expected: the stages of an accepted step were finite
             raise NonFiniteError("the dense output of a step became non-finite")
 
@@ -800,16 +808,17 @@ def _stretch_budget_ends(budget, steps, kept, T, H, t_end, recent):
 
 
 def _run_adaptive_compiled(rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events,
-                           t_eval, progress, monitor, budget):
+                           t_eval, progress, monitor, budget, programs):
     """RK45 or DOP853 as compiled stretches of accepted steps (``kernels.adaptive``): the
     same steps as scipy's solvers; after each stretch, in Python and on whole arrays: the
     singularity monitor, the events (crossings located by brentq on the compiled dense
-    output), the budgets, progress.  Output times are sampled inside the stretch."""
+    output), the budgets, progress.  Output times are sampled inside the stretch; the
+    drives are evaluated there by their ``programs`` (``mbdyn.programs``)."""
     from .kernels.adaptive import TABLEAUS, initial_step, rk_stretch
     model = rhs.model
     nq, n = model.nq, y0.size
     tab = TABLEAUS[integrator]
-    kind, A, B, E, E3, D = tab.arrays()
+    kind, A, B, C, E, E3, D = tab.arrays()
     if rtol < 100 * np.finfo(float).eps:        # as scipy's solvers do
         warnings.warn("At least one element of `rtol` is too small. Setting "
                       f"`rtol = np.maximum(rtol, {100 * np.finfo(float).eps})`.", stacklevel=3)
@@ -847,7 +856,7 @@ def _run_adaptive_compiled(rhs, integrator, t0, t_end, y0, rtol, atol, max_step,
     steps = 0
     recent = np.empty(0)                            # the last PROJECTION_STEPS step sizes
     nfev = np.zeros(1, np.int64)
-    fail_y = np.empty(n)
+    fail = np.empty(n + 1)                          # a failing stage's time and state
     t, y = t0, y0.copy()
     stretch = STRETCH_FIRST
     most = STRETCH_MOST_EVENTS if events else STRETCH_MOST
@@ -860,10 +869,10 @@ def _run_adaptive_compiled(rhs, integrator, t0, t_end, y0, rtol, atol, max_step,
         out_K = np.empty((m if events else 0, tab.stages, n))
         t_start, y_start, i_start = t, y.copy(), i_eval
         cpu = _time.process_time()
-        acc, status, h_abs, i_eval = rk_stretch(kind, A, B, E, E3, D, t, t_end, y, f, h_abs,
-                                                rtol, atol, max_step, m, grid, i_eval,
-                                                samples, *args, out_t, out_y, out_h,
-                                                out_nfev, out_ieval, out_K, fail_y, nfev)
+        acc, status, h_abs, i_eval = rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f,
+                                                h_abs, rtol, atol, max_step, m, grid, i_eval,
+                                                samples, *programs, *args, out_t, out_y,
+                                                out_h, out_nfev, out_ieval, out_K, fail, nfev)
         if _time.process_time() - cpu < STRETCH_CPU and stretch < most:
             stretch *= 2
         T, Y, H = out_t[:acc], out_y[:acc], out_h[:acc]
@@ -872,7 +881,8 @@ def _run_adaptive_compiled(rhs, integrator, t0, t_end, y0, rtol, atol, max_step,
         ends, G, hits_by_row = [], None, {}
         if events and acc:
             G, ends, hits_by_row = _stretch_events(events, model, g_old, t_start, y_start,
-                                                   T, Y, H, out_K, tab, dense_args, nfev)
+                                                   T, Y, H, out_K, tab, programs + dense_args,
+                                                   nfev)
         kept = (stored + 1 + np.arange(acc)) if t_eval is None else out_ieval[:acc]
         ends += _stretch_budget_ends(budget, steps, kept, T, H, t_end, recent)
         history = np.concatenate([recent, H])
@@ -938,7 +948,7 @@ def _run_adaptive_compiled(rhs, integrator, t0, t_end, y0, rtol, atol, max_step,
                            "an implicit method (Radau, BDF) if the model is stiff")
             else:
                 try:
-                    model.state_derivative(t, fail_y)
+                    model.state_derivative(fail[0], fail[1:])
                     exc = _LOOP_STATUS[status](model)
                 except (NonFiniteError, SingularMassMatrixError) as raised:
                     exc = raised

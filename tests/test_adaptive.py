@@ -5,6 +5,7 @@ import warnings
 
 import numpy as np
 import pytest
+import sympy as sp
 
 import mbdyn as mb
 import importlib
@@ -94,13 +95,15 @@ def test_a_non_finite_stage_stops_the_kernel_with_its_state(pendulum):
     f = np.array([0.0, 0.0, 1e308, 1e308])
     m, n = 4, y.size
     out = (np.empty(m), np.empty((m, n)), np.empty(m), np.empty(m, np.int64),
-           np.empty(m, np.int64), np.empty((0, tab.stages, n)), np.empty(n),
+           np.empty(m, np.int64), np.empty((0, tab.stages, n)), np.empty(n + 1),
            np.zeros(1, np.int64))
+    no_drives = (np.empty((0, 2), np.int64), np.empty(0), np.zeros(1, np.int64))
     acc, status, _, _ = ka.rk_stretch(*tab.arrays(), 0.0, 1.0, y, f, 10.0, 1e-9, 1e-12,
-                                      np.inf, m, np.empty(0), 0, np.empty((0, n)), *args, *out)
+                                      np.inf, m, np.empty(0), 0, np.empty((0, n)), *no_drives,
+                                      *args, *out)
     assert (acc, status) == (0, 1)
     with pytest.raises(mb.NonFiniteError, match="non-finite"):
-        pendulum.state_derivative(0.0, out[6])          # the stage state it left
+        pendulum.state_derivative(out[6][0], out[6][1:])    # the stage it left
 
 
 # ---------------------------------------------------------------- against scipy's solvers
@@ -257,16 +260,63 @@ def test_the_singularity_monitor_stops_both_paths_alike():
 
 
 # ---------------------------------------------------------------------- where it applies
-def test_models_with_drives_or_function_loads_take_scipys_path(pendulum):
+def test_models_with_function_loads_or_untranslatable_drives_take_scipys_path(pendulum):
     s = double_pendulum_system(**DOUBLE_PENDULUM_DATA)
     s.add_load("push", "link2", force=lambda t, q, u: (0.001 * np.sin(t), 0.0, 0.0))
     assert not mb.simulate(s.compile(), 0.2, P0).stats["compiled"]
     assert not mb.simulate(pendulum, 0.2, P0, compiled_loop=False).stats["compiled"]
     assert not mb.simulate(pendulum, 0.2, P0, method="newton-euler").stats["compiled"]
     assert mb.simulate(pendulum, 0.2, P0).stats["compiled"]
-    rot = load_model(MODELS / "rotating_pendulum.toml")            # driven joints
+    t = mb.t
+    for drive in (sp.Piecewise((t ** 3, t < 1), (3 * t - 2, True)),            # no program
+                  (lambda x: 0.1 * x, lambda x: 0.1, lambda x: 0.0)):          # Python
+        s = mb.System("driven", gravity=(0, -9.81, 0))
+        s.add_body("arm", mass=1.0, com=(0.1, 0, 0), inertia=np.eye(3) * 1e-3)
+        s.add_joint("turn", "revolute", "ground", "arm", axis="y", drive=drive)
+        s.add_body("bob", mass=1.0, com=(0, -0.5, 0))
+        s.add_joint("swing", "revolute", "arm", "bob", axis="z", position=(0.1, 0, 0))
+        assert not mb.simulate(s.compile(), 0.2, {"swing": 0.3}).stats["compiled"]
+
+
+@pytest.mark.parametrize("integrator", PAIRS)
+def test_driven_models_run_compiled_and_agree_with_scipy(integrator):
+    """Drives as programs evaluated at each stage time (``mbdyn.programs``): the rotating
+    pendulum (two driven joints) and a drive with elementary functions."""
+    rot = load_model(MODELS / "rotating_pendulum.toml")
     assert rot.model.driven_joints
-    assert not rot.simulate(t_end=0.05).stats["compiled"]
+    a = rot.simulate(t_end=0.5, integrator=integrator)
+    b = rot.simulate(t_end=0.5, integrator="scipy-" + integrator)
+    assert a.stats["compiled"] and not b.stats["compiled"]
+    assert np.array_equal(a.t, b.t) and np.abs(a.q - b.q).max() < 1e-8
+    t = mb.t
+    s = mb.System("shaken", gravity=(0, -9.81, 0))
+    s.add_body("cart", mass=1.0)
+    s.add_joint("shake", "prismatic", "ground", "cart", axis="x",
+                drive=0.05 * sp.sin(7 * t) * sp.exp(-t / 2) + sp.atan(t) ** 2 / 10)
+    s.add_body("bob", mass=1.0, com=(0, -0.5, 0))
+    s.add_joint("swing", "revolute", "cart", "bob", axis="z")
+    model = s.compile()
+    a, b = _pair(model, integrator, 2.0, {"swing": 0.3}, rtol=1e-10, atol=1e-12,
+                 t_eval=np.linspace(0, 2, 21))
+    assert np.abs(a.q - b.q).max() < 1e-8 and np.abs(a.u - b.u).max() < 1e-7
+    assert abs(a.stats["steps"] - b.stats["steps"]) <= max(2, 0.03 * b.stats["steps"])
+
+
+def test_drive_programs_evaluate_as_the_drives_do():
+    from mbdyn.elements import make_drive
+    from mbdyn.kernels.programs import STACK, drive_values
+    from mbdyn.programs import drive_programs
+    t = mb.t
+    exprs = (3 * t, sp.sin(2 * t) ** 2 + sp.exp(-t / 3) * sp.cos(t),
+             sp.Rational(1, 2) * t ** 2 - sp.pi * t, sp.sqrt(t + 1) + sp.log(t + 2) + sp.atan(t),
+             sp.tanh(t) * sp.cosh(t / 4) + sp.atan2(t, 2) + sp.asin(t / 9) * sp.tan(t / 5))
+    drives = [make_drive(e, "j") for e in exprs]
+    programs = drive_programs(drives)
+    out = np.empty((len(drives), 3))
+    for tt in (0.0, 0.37, 1.9, -0.6):
+        drive_values(*programs, tt, np.empty(STACK), out)
+        ref = [[d.position(tt), d.velocity(tt), d.acceleration(tt)] for d in drives]
+        assert np.allclose(out, ref, rtol=1e-14, atol=1e-14), tt
 
 
 def test_scipy_names_are_valid_in_model_files(tmp_path):

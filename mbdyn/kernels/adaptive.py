@@ -16,15 +16,17 @@ Dense output (Hairer's continuous extensions): a polynomial in ``x = (t - t_old)
 ``F1 = h f_old - F0``, ``F2 = F0 - h f_new - F1`` and the rest ``h D K`` (4th order for
 RK45 from its seven stages, 7th order for DOP853 after three more stages).
 
-The model must have no drives and no Python-function loads: the right-hand side is then
-autonomous and needs no stage times.  Status codes: 0 done (stretch full or ``t_end``
-reached), 1 non-finite derivative, 2 mass matrix not positive definite (both at the stage
-state left in ``fail_y``), 4 step size below the roundoff of ``t``.
+The model must have no Python-function loads; its drives come as programs of
+``kernels.programs`` (``drives = (ops, consts, starts)``), evaluated at each stage time.
+Status codes: 0 done (stretch full or ``t_end`` reached), 1 non-finite derivative, 2 mass
+matrix not positive definite (both at the stage time and state left in ``fail``), 4 step
+size below the roundoff of ``t``.
 """
 import numpy as np
 from numba import njit
 
 from .integrators import _rhs
+from .programs import STACK, drive_values
 
 RK45, DOP853 = 0, 1
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
@@ -162,7 +164,7 @@ class Tableau:
         self.stages, self.order = stages, order
 
     def arrays(self):
-        return self.kind, self.A, self.B, self.E, self.E3, self.D
+        return self.kind, self.A, self.B, self.C, self.E, self.E3, self.D
 
 
 TABLEAUS = {
@@ -190,6 +192,16 @@ def initial_step(fun, y0, f0, span, max_step, order, rtol, atol):
 
 
 @njit(cache=True, inline="always")
+def _stage(t, y, ops, consts, starts, stack, dv, nq, slots, free_q, free_u, drive_q, drive_u,
+           tree, body, loads, ws, ydot, nfev):
+    """The right-hand side at time ``t`` (drives evaluated there) and state ``y``."""
+    if dv.shape[0]:
+        drive_values(ops, consts, starts, t, stack, dv)
+    return _rhs(y, dv, nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads, ws,
+                ydot, nfev)
+
+
+@njit(cache=True, inline="always")
 def _combine(y, h, A, s, K, out):
     """``out = y + h sum_j<s A[s, j] K[j]`` (the state at stage ``s``)."""
     n = y.shape[0]
@@ -203,15 +215,18 @@ def _combine(y, h, A, s, K, out):
 
 
 @njit(cache=True, inline="always")
-def _dense_coefficients(A, D, stages, y_old, y_new, h, K, F, tmp, no_drives, nq, slots,
-                        free_q, free_u, drive_q, drive_u, tree, body, loads, ws, nfev):
+def _dense_coefficients(A, C, D, stages, t_old, y_old, y_new, h, K, F, tmp, ops, consts, starts,
+                        stack, dv, nq, slots, free_q, free_u, drive_q, drive_u, tree, body,
+                        loads, ws, fail, nfev):
     """``F`` (rows of the dense polynomial) of the step ``y_old -> y_new`` whose stages are
     ``K[:stages]``; computes the extra stages ``K[stages:]`` first (DOP853: three)."""
     for s in range(stages, K.shape[0]):
         _combine(y_old, h, A, s, K, tmp)
-        st = _rhs(tmp, no_drives, nq, slots, free_q, free_u, drive_q, drive_u, tree, body,
-                  loads, ws, K[s], nfev)
+        st = _stage(t_old + C[s] * h, tmp, ops, consts, starts, stack, dv, nq, slots, free_q,
+                    free_u, drive_q, drive_u, tree, body, loads, ws, K[s], nfev)
         if st:
+            fail[0] = t_old + C[s] * h
+            fail[1:] = tmp
             return st
     n = y_old.shape[0]
     f_new = K[stages - 1]
@@ -245,25 +260,27 @@ def _dense_value(F, y_old, x, out):
 
 
 @njit(cache=True)
-def rk_stretch(kind, A, B, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_step, max_accept,
-               t_eval, i_eval, samples, nq, slots, quats, free_q, free_u, drive_q, drive_u,
-               tree, body, loads, ws, out_t, out_y, out_h, out_nfev, out_ieval, out_K,
-               fail_y, nfev):
+def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_step,
+               max_accept, t_eval, i_eval, samples, ops, consts, starts, nq, slots, quats,
+               free_q, free_u, drive_q, drive_u, tree, body, loads, ws, out_t, out_y, out_h,
+               out_nfev, out_ieval, out_K, fail, nfev):
     """Up to ``max_accept`` accepted steps from ``(t, y)`` (``f`` its derivative, ``h_abs``
     the proposed step) towards ``t_end``.  Accepted step ``k``: ``out_t[k]``,
     ``out_y[k]``, its size ``out_h[k]``, the evaluations so far ``out_nfev[k]``, the
     samples so far ``out_ieval[k]``; its stages in ``out_K[k]`` when ``out_K`` has rows.
     Output times ``t_eval[i_eval:]`` passed are sampled on the dense output into
     ``samples``.  ``y``, ``f`` end as the last accepted state and its derivative.
-    Returns ``(accepted, status, h_abs, i_eval)``; ``quats`` is unused (no projection: the
-    drift is reported, as with scipy's solvers)."""
+    On failure ``fail`` holds the stage's time, then its state.  Returns
+    ``(accepted, status, h_abs, i_eval)``; ``quats`` is unused (no projection: the drift is
+    reported, as with scipy's solvers)."""
     n = y.shape[0]
     stages = B.shape[0] + 1
     K = np.empty((A.shape[0], n))
     y_new = np.empty(n)
     tmp = np.empty(n)
     F = np.empty((3 + D.shape[0], n))
-    no_drives = np.zeros((0, 3))
+    stack = np.empty(STACK)
+    dv = np.empty((drive_q.shape[0], 3))
     keep_stages = out_K.shape[0] > 0
     exponent = -1.0 / (5.0 if kind == RK45 else 8.0)
     accepted = 0
@@ -287,22 +304,23 @@ def rk_stretch(kind, A, B, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_step
             st = 0
             for s in range(1, stages - 1):
                 _combine(y, h, A, s, K, tmp)
-                st = _rhs(tmp, no_drives, nq, slots, free_q, free_u, drive_q, drive_u, tree,
-                          body, loads, ws, K[s], nfev)
+                st = _stage(t + C[s] * h, tmp, ops, consts, starts, stack, dv, nq, slots,
+                            free_q, free_u, drive_q, drive_u, tree, body, loads, ws, K[s],
+                            nfev)
                 if st:
-                    break
-            if st:
-                fail_y[:] = tmp
-                return accepted, st, h_abs, i_eval
+                    fail[0] = t + C[s] * h
+                    fail[1:] = tmp
+                    return accepted, st, h_abs, i_eval
             for i in range(n):
                 acc = 0.0
                 for j in range(stages - 1):
                     acc += B[j] * K[j, i]
                 y_new[i] = y[i] + h * acc
-            st = _rhs(y_new, no_drives, nq, slots, free_q, free_u, drive_q, drive_u, tree,
-                      body, loads, ws, K[stages - 1], nfev)
+            st = _stage(t_new, y_new, ops, consts, starts, stack, dv, nq, slots, free_q,
+                        free_u, drive_q, drive_u, tree, body, loads, ws, K[stages - 1], nfev)
             if st:
-                fail_y[:] = y_new
+                fail[0] = t_new
+                fail[1:] = y_new
                 return accepted, st, h_abs, i_eval
             # error norm
             if kind == RK45:
@@ -347,11 +365,10 @@ def rk_stretch(kind, A, B, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_step
             rejected = True
         # accepted: sample the output times passed, then move on
         if i_eval < t_eval.shape[0] and t_eval[i_eval] <= t_new:
-            st = _dense_coefficients(A, D, stages, y, y_new, h, K, F, tmp, no_drives, nq,
-                                     slots, free_q, free_u, drive_q, drive_u, tree, body,
-                                     loads, ws, nfev)
+            st = _dense_coefficients(A, C, D, stages, t, y, y_new, h, K, F, tmp, ops, consts,
+                                     starts, stack, dv, nq, slots, free_q, free_u, drive_q,
+                                     drive_u, tree, body, loads, ws, fail, nfev)
             if st:
-                fail_y[:] = tmp
                 return accepted, st, h_abs, i_eval
             while i_eval < t_eval.shape[0] and t_eval[i_eval] <= t_new:
                 _dense_value(F, y, (t_eval[i_eval] - t) / h, samples[i_eval])
@@ -374,8 +391,8 @@ def rk_stretch(kind, A, B, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_step
 
 
 @njit(cache=True)
-def dense_step(A, D, stages, y_old, y_new, h, K_step, nq, slots, free_q, free_u, drive_q,
-               drive_u, tree, body, loads, ws, nfev):
+def dense_step(A, C, D, stages, t_old, y_old, y_new, h, K_step, ops, consts, starts, nq,
+               slots, free_q, free_u, drive_q, drive_u, tree, body, loads, ws, nfev):
     """The dense polynomial ``F`` of one accepted step from its stages ``K_step``
     (``out_K[k]`` of ``rk_stretch``); returns ``(F, status)``."""
     n = y_old.shape[0]
@@ -383,9 +400,11 @@ def dense_step(A, D, stages, y_old, y_new, h, K_step, nq, slots, free_q, free_u,
     K[:stages] = K_step[:stages]
     F = np.empty((3 + D.shape[0], n))
     tmp = np.empty(n)
-    st = _dense_coefficients(A, D, stages, y_old, y_new, h, K, F, tmp, np.zeros((0, 3)), nq,
+    fail = np.empty(n + 1)
+    st = _dense_coefficients(A, C, D, stages, t_old, y_old, y_new, h, K, F, tmp, ops, consts,
+                             starts, np.empty(STACK), np.empty((drive_q.shape[0], 3)), nq,
                              slots, free_q, free_u, drive_q, drive_u, tree, body, loads, ws,
-                             nfev)
+                             fail, nfev)
     return F, st
 
 
