@@ -3,7 +3,9 @@
 Adaptive integrators are scipy's ``OdeSolver`` classes (RK45, RK23, DOP853, Radau, BDF,
 LSODA), stepped here one accepted step at a time so that events are located on the dense
 output, a failure keeps the results computed before it, and NaN/Inf stops the run with the
-time and the state.  Fixed-step schemes: explicit Euler, semi-implicit (symplectic) Euler --
+time and the state; RK45 and DOP853 run instead as compiled stretches of steps
+(``kernels.adaptive``) where the model allows, examined stretch by stretch with the same
+results.  Fixed-step schemes: explicit Euler, semi-implicit (symplectic) Euler --
 the textbook's scheme, velocities first, then positions with the new velocities -- and
 classic RK4; quaternions are projected back onto the unit sphere after every step.
 """
@@ -337,8 +339,9 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     Euler-angle joint comes this close to its singularity (see ``Model.euler_singularity``).
     ``compiled_loop``: run fixed-step schemes, RK45 and DOP853 in compiled stretches when
     the model allows (``method="jourdain"``, no Python-function loads and, for RK45 and
-    DOP853, no drives); ``False`` forces the Python loop (scipy's solvers for RK45 and
-    DOP853, which ``"scipy-RK45"`` and ``"scipy-DOP853"`` also name).
+    DOP853, drives that ``mbdyn.programs`` translates); ``False`` forces the Python loop
+    (scipy's solvers for RK45 and DOP853, which ``"scipy-RK45"`` and ``"scipy-DOP853"``
+    also name).
     ``decimate``: fixed-step schemes store every ``decimate``-th step (and the last).
 
     Budgets (``mbdyn.limits``; ``docs/reliability.md``): ``max_steps`` integrator steps
