@@ -345,3 +345,11 @@ def test_scipy_names_on_the_command_line(capsys):
     for name in ("scipy-DOP853", "scipy-RK45", "RK45"):
         assert main(["run", path, "--t-end", "0.05", "--integrator", name]) == 0
         assert f"integrator {name}," in capsys.readouterr().out
+
+
+def test_max_wall_time_stops_the_compiled_path_between_stretches(pendulum):
+    with pytest.raises(mb.SimulationError, match="max_wall_time") as info:
+        mb.simulate(pendulum, 40.0, P0, max_wall_time=1e-9)
+    kept = info.value.result
+    assert kept.stats["compiled"] and 0 < kept.t[-1] < 40.0
+    assert kept.stats["steps"] == len(kept.t) - 1
