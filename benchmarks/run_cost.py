@@ -6,9 +6,9 @@ Each tree runs in its own subprocess (``PYTHONPATH=tree``), alternating, after o
 untimed warm-up each (numba compiles into each tree's own cache); in each process a short
 untimed run comes first, so that imports and the first call's dispatch are not counted
 (``benchmarks/first_start.py`` measures those).  Measures: the
-textbook double pendulum over 4 s with DOP853 at rtol 1e-9 (adaptive loop: events,
-budgets and the step projection run every step) and with rk4 at dt = 4/48000 (the
-compiled fixed-step loop); medians of wall time and the ratio HEAD / baseline.  Prints a
+textbook double pendulum over 4 s with DOP853 at rtol 1e-9 (compiled stretches of
+adaptive steps since kernels/adaptive.py; scipy's solver stepped from Python before) and
+with rk4 at dt = 4/48000 (the compiled fixed-step loop); medians of wall time and the ratio HEAD / baseline.  Prints a
 markdown table.  With no ``--baseline`` only this tree is measured.
 """
 from __future__ import annotations

@@ -3,7 +3,9 @@
 Adaptive integrators are scipy's ``OdeSolver`` classes (RK45, RK23, DOP853, Radau, BDF,
 LSODA), stepped here one accepted step at a time so that events are located on the dense
 output, a failure keeps the results computed before it, and NaN/Inf stops the run with the
-time and the state.  Fixed-step schemes: explicit Euler, semi-implicit (symplectic) Euler --
+time and the state; RK45 and DOP853 run instead as compiled stretches of steps
+(``kernels.adaptive``) where the model allows, examined stretch by stretch with the same
+results.  Fixed-step schemes: explicit Euler, semi-implicit (symplectic) Euler --
 the textbook's scheme, velocities first, then positions with the new velocities -- and
 classic RK4; quaternions are projected back onto the unit sphere after every step.
 """
@@ -25,16 +27,17 @@ from .compile import METHODS as _METHODS
 from .errors import (ModelError, ModelWarning, NonFiniteError, SimulationError,
                      SingularityWarning, SingularMassMatrixError)
 
-
 class _ScipySolvers(collections.abc.Mapping):
     """scipy's ``OdeSolver`` classes by name, ``scipy.integrate`` imported on the first
-    look-up of a class (a fixed-step run does not need it)."""
-    NAMES = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+    look-up of a class (a fixed-step run does not need it).  ``scipy-RK45`` and
+    ``scipy-DOP853`` always take scipy's solver; ``RK45`` and ``DOP853`` run compiled
+    (``kernels.adaptive``) where the model allows."""
+    NAMES = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA", "scipy-RK45", "scipy-DOP853")
 
     def __getitem__(self, name):
         if name not in self.NAMES:
             raise KeyError(name)
-        return getattr(scipy.integrate, name)
+        return getattr(scipy.integrate, name.removeprefix("scipy-"))
 
     def __iter__(self):
         return iter(self.NAMES)
@@ -44,6 +47,9 @@ class _ScipySolvers(collections.abc.Mapping):
 
 
 ADAPTIVE = _ScipySolvers()
+#: adaptive pairs that also run as compiled stretches (``kernels.adaptive``); their
+#: ``scipy-`` names always take scipy's solver
+COMPILED_ADAPTIVE = ("RK45", "DOP853")
 FIXED_STEP = ("euler", "semi-implicit-euler", "rk4", "implicit-midpoint")
 INTEGRATORS = tuple(ADAPTIVE) + FIXED_STEP
 OUTPUTS = ("reactions", "energy", "momentum")
@@ -352,8 +358,11 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     reactions).  ``progress``: optional callable
     ``progress(t)`` called after each step.  ``singularity_threshold``: stop when an
     Euler-angle joint comes this close to its singularity (see ``Model.euler_singularity``).
-    ``compiled_loop``: run fixed-step schemes in compiled stretches when the model allows
-    (``method="jourdain"`` and no Python-function loads); ``False`` forces the Python loop.
+    ``compiled_loop``: run fixed-step schemes, RK45 and DOP853 in compiled stretches when
+    the model allows (``method`` ``"jourdain"`` or ``"articulated"``, no Python-function loads and, for RK45 and
+    DOP853, drives that ``mbdyn.programs`` translates); ``False`` forces the Python loop
+    (scipy's solvers for RK45 and DOP853, which ``"scipy-RK45"`` and ``"scipy-DOP853"``
+    also name).
     ``decimate``: fixed-step schemes store every ``decimate``-th step (and the last).
 
     Budgets (``mbdyn.limits``; ``docs/reliability.md``): ``max_steps`` integrator steps
@@ -453,9 +462,20 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     budget["deadline"] = (None if budget["max_wall_time"] is None
                           else start + budget["max_wall_time"])
     if integrator in ADAPTIVE:
-        ts, ys, found, info = _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol,
-                                            max_step, events, t_eval, progress, monitor,
-                                            budget)
+        programs = None
+        if (compiled_loop and integrator in COMPILED_ADAPTIVE
+                and method in ("jourdain", "articulated")
+                and not model.has_callable_loads and y0.size > 0):
+            from .programs import drive_programs
+            programs = drive_programs([d[3] for d in model._driven])
+        if programs is not None:
+            ts, ys, found, info = _run_adaptive_compiled(
+                rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events, t_eval,
+                progress, monitor, budget, programs)
+        else:
+            ts, ys, found, info = _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol,
+                                                max_step, events, t_eval, progress, monitor,
+                                                budget)
     else:
         compiled = (compiled_loop and method in ("jourdain", "articulated")
                     and not model.has_callable_loads)
@@ -700,12 +720,279 @@ def _run_adaptive(rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events, 
             if failure:
                 break
     info = {"steps": steps, "njev": getattr(solver, "njev", 0), "nlu": getattr(solver, "nlu", 0),
-            "solver_rhs_evaluations": solver.nfev}
+            "solver_rhs_evaluations": solver.nfev, "compiled": False}
     if failure is not None:
         info["failure"] = failure
     if not ts:
         ts, ys = [solver.t], [solver.y.copy()]
     return np.array(ts), np.array(ys), found, info
+
+
+#: accepted steps per compiled stretch: the first, and the most (with events: a terminal
+#: event wastes at most a stretch); a stretch doubles while it takes under STRETCH_CPU s
+STRETCH_FIRST, STRETCH_MOST, STRETCH_MOST_EVENTS, STRETCH_CPU = 64, 4096, 256, 0.02
+
+
+def _event_rows(events, model, ts, ys):
+    """Every event's condition at the rows ``(ts, ys)``: ``(len(ts), len(events))``, NaN
+    and Inf left in.  Conditions from text or sympy are evaluated on the whole columns."""
+    from .events import CompiledCondition
+    nq = model.nq
+    out = np.empty((len(ts), len(events)))
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        for k, e in enumerate(events):
+            g = e.condition
+            if isinstance(g, CompiledCondition):
+                try:
+                    v = np.asarray(g.fn(ts, *ys.T), dtype=float)
+                    if v.shape in ((), ts.shape):
+                        out[:, k] = v
+                        continue
+                except (TypeError, ValueError):
+                    pass                # not vectorizable: row by row below
+            out[:, k] = [float(g(t, y[:nq], y[nq:])) for t, y in zip(ts, ys)]
+    return out
+
+
+def _crossed_rows(e, g_old, g_new):
+    """``_crossed`` over arrays."""
+    up = (g_old < 0) & (g_new >= 0)
+    down = (g_old > 0) & (g_new <= 0)
+    return up if e.direction > 0 else down if e.direction < 0 else up | down
+
+
+def _stretch_events(events, model, g_old, t_start, y_start, T, Y, H, out_K, tab, dense_args,
+                    nfev):
+    """The events of a stretch of accepted steps ``(T, Y, H)`` after ``(t_start, y_start)``
+    (conditions ``g_old`` there; ``dense_args``: the drive programs and the model's arrays
+    after ``dense_step``'s first ones): ``(G, ends, found)`` -- the conditions at every row, the
+    rows where the stretch ends (``(row, 1, "event")`` at a non-finite condition,
+    ``(row, 2, "terminal", t_event, state_at)``) and ``{row: [EventRecord, ...]}``, each
+    crossing located by brentq on the step's dense polynomial."""
+    from .kernels.adaptive import dense_step, dense_values
+    nq = model.nq
+    ends, found = [], {}
+    G = _event_rows(events, model, T, Y)
+    bad = np.flatnonzero(~np.all(np.isfinite(G), axis=1))
+    if bad.size:
+        ends.append((int(bad[0]), 1, "event"))
+    last = int(bad[0]) if bad.size else len(T)
+    before = np.vstack([g_old[None, :], G[:-1]])
+    crossing = np.zeros(G.shape, bool)
+    for k, e in enumerate(events):
+        crossing[:last, k] = _crossed_rows(e, before[:last, k], G[:last, k])
+    for r in np.flatnonzero(crossing.any(axis=1)):
+        t_old = T[r - 1] if r else t_start
+        y_old = Y[r - 1] if r else y_start
+        F, st = dense_step(tab.A, tab.C, tab.D, tab.stages, t_old, y_old, Y[r], H[r], out_K[r],
+                           *dense_args, nfev)
+        if st:          # not expected: the stages of an accepted step were finite
+            raise NonFiniteError("the dense output of a step became non-finite")
+
+        def state_at(tt, F=F, y_old=y_old, t_old=t_old, h=H[r]):
+            return dense_values(F, y_old, (tt - t_old) / h)[0]
+        hits = []
+        for k, e in enumerate(events):
+            if crossing[r, k]:
+                def g(tt, e=e):
+                    yy = state_at(tt)
+                    return float(e.condition(tt, yy[:nq], yy[nq:]))
+                te = scipy.optimize.brentq(g, t_old, T[r], xtol=4 * np.finfo(float).eps,
+                                     rtol=4 * np.finfo(float).eps)
+                hits.append((te, e))
+        records = found[int(r)] = []
+        for te, e in sorted(hits, key=lambda h: h[0]):
+            ye = state_at(te)
+            records.append(EventRecord(e.name, te, ye[:nq], ye[nq:],
+                                       model.coordinates + model.speeds))
+            if e.terminal:
+                ends.append((int(r), 2, "terminal", te, state_at))
+                return G, ends, found
+    return G, ends, found
+
+
+def _stretch_budget_ends(budget, steps, kept, T, H, t_end, recent):
+    """The first row of a stretch after which a budget is used up, as on scipy's path
+    (checked after every step that did not finish the run): ``[(row, 3 or 4, "budget",
+    message)]`` or ``[]``.  ``steps`` were taken before the stretch; ``kept[r]`` samples
+    are stored after row ``r``; ``recent``: the step sizes before the stretch."""
+    ends = []
+    going = T < t_end
+    counts = steps + 1 + np.arange(len(T))
+    over = np.flatnonzero(going & ((counts >= budget["max_steps"])
+                                   | (kept > budget["max_samples"])))
+    if over.size:
+        r = int(over[0])
+        ends.append((r, 3, "budget", _over_budget(budget, int(counts[r]), int(kept[r]), T[r],
+                                                  t_end, h=H[r])))
+    history = np.concatenate([recent, H])
+    for r in np.flatnonzero(going & (counts % PROJECTION_STEPS == 0)):
+        tail = history[:len(recent) + r + 1][-PROJECTION_STEPS:]
+        message = _projected_over_budget(budget, int(counts[r]), T[r], t_end, tail)
+        if message:
+            ends.append((int(r), 4, "budget", message))
+            break
+    return ends
+
+
+def _run_adaptive_compiled(rhs, integrator, t0, t_end, y0, rtol, atol, max_step, events,
+                           t_eval, progress, monitor, budget, programs):
+    """RK45 or DOP853 as compiled stretches of accepted steps (``kernels.adaptive``): the
+    same steps as scipy's solvers; after each stretch, in Python and on whole arrays: the
+    singularity monitor, the events (crossings located by brentq on the compiled dense
+    output), the budgets, progress.  Output times are sampled inside the stretch; the
+    drives are evaluated there by their ``programs`` (``mbdyn.programs``)."""
+    from .kernels.adaptive import TABLEAUS, initial_step, rk_stretch
+    model = rhs.model
+    nq, n = model.nq, y0.size
+    tab = TABLEAUS[integrator]
+    kind, A, B, C, E, E3, D = tab.arrays()
+    if rtol < 100 * np.finfo(float).eps:        # as scipy's solvers do
+        warnings.warn("At least one element of `rtol` is too small. Setting "
+                      f"`rtol = np.maximum(rtol, {100 * np.finfo(float).eps})`.", stacklevel=3)
+        rtol = 100 * np.finfo(float).eps
+
+    def derivative(t, y):
+        rhs.evaluations += 1
+        return model.state_derivative(t, y, rhs.method)
+
+    try:
+        f = derivative(t0, y0)
+        h_abs = initial_step(lambda h, y: derivative(t0 + h, y), y0, f, t_end - t0,
+                             max_step, tab.order, rtol, atol)
+    except (NonFiniteError, SingularMassMatrixError) as exc:
+        raise SimulationError(_describe_failure(model, exc, t0, y0),
+                              Result(model, [t0], y0[None, :nq], y0[None, nq:],
+                                     [], {})) from exc
+    start_evaluations = rhs.evaluations
+    args = model.loop_arguments(rhs.method)
+    dense_args = args[:2] + args[3:]                # dense_step takes no quaternion list
+    if t_eval is not None:
+        samples = np.empty((len(t_eval), n))
+        i_eval = 1 if t_eval[0] == t0 else 0
+        samples[:i_eval] = y0
+        times, states = [t_eval[:i_eval]], [samples[:i_eval]]
+        grid = t_eval
+    else:
+        samples = np.empty((0, n))
+        i_eval = 0
+        times, states = [np.array([t0])], [y0[None, :].copy()]
+        grid = np.empty(0)
+    stored = 1 if t_eval is None else i_eval
+    g_old = _event_values(events, model, t0, y0) if events else None
+    found = []
+    steps = 0
+    recent = np.empty(0)                            # the last PROJECTION_STEPS step sizes
+    nfev = np.zeros(1, np.int64)
+    fail = np.empty(n + 1)                          # a failing stage's time and state
+    t, y = t0, y0.copy()
+    stretch = STRETCH_FIRST
+    most = STRETCH_MOST_EVENTS if events else STRETCH_MOST
+    failure = None
+    while t < t_end and failure is None:
+        m = int(min(stretch, budget["max_steps"] - steps))
+        out_t, out_h = np.empty(m), np.empty(m)
+        out_y = np.empty((m, n))
+        out_nfev, out_ieval = np.empty(m, np.int64), np.empty(m, np.int64)
+        out_K = np.empty((m if events else 0, tab.stages, n))
+        t_start, y_start, i_start = t, y.copy(), i_eval
+        cpu = _time.process_time()
+        acc, status, h_abs, i_eval = rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f,
+                                                h_abs, rtol, atol, max_step, m, grid, i_eval,
+                                                samples, *programs, *args, out_t, out_y,
+                                                out_h, out_nfev, out_ieval, out_K, fail, nfev)
+        if _time.process_time() - cpu < STRETCH_CPU and stretch < most:
+            stretch *= 2
+        T, Y, H = out_t[:acc], out_y[:acc], out_h[:acc]
+        # where this stretch ends: (row, reason) in the order a step is examined --
+        # singularity monitor, events, budgets
+        ends, G, hits_by_row = [], None, {}
+        if events and acc:
+            G, ends, hits_by_row = _stretch_events(events, model, g_old, t_start, y_start,
+                                                   T, Y, H, out_K, tab, programs + dense_args,
+                                                   nfev)
+        kept = (stored + 1 + np.arange(acc)) if t_eval is None else out_ieval[:acc]
+        ends += _stretch_budget_ends(budget, steps, kept, T, H, t_end, recent)
+        history = np.concatenate([recent, H])
+        end = min(ends, key=lambda x: (x[0], x[1])) if ends else None
+        upto = end[0] + 1 if end else acc
+        n_ok, monitor_failure = monitor.check_rows(T[:upto], Y[:upto])
+        if monitor_failure:
+            end = (n_ok, 0, "monitor", monitor_failure)
+        # the rows kept, the events found in them, the samples
+        last_row = end[0] if end else acc - 1      # the last row examined
+        keep = end[0] + (1 if end[2] == "budget" else 0) if end else acc
+        for r in sorted(hits_by_row):
+            if r < keep or (end and end[2] == "terminal" and r == end[0]):
+                found.extend(hits_by_row[r])
+        steps += last_row + 1
+        stop_at = end[3] if end and end[2] == "terminal" else None
+        if t_eval is None:
+            times.append(T[:keep].copy())
+            states.append(Y[:keep].copy())
+            stored += keep
+            if stop_at is not None:
+                times.append(np.array([stop_at]))
+                states.append(end[4](stop_at)[None, :])
+                stored += 1
+        else:
+            upto_eval = (int(np.searchsorted(t_eval, stop_at, side="right"))
+                         if stop_at is not None else out_ieval[keep - 1] if keep else i_start)
+            upto_eval = min(max(upto_eval, i_start), i_eval if acc else i_start)
+            times.append(t_eval[i_start:upto_eval])
+            states.append(samples[i_start:upto_eval])
+            stored = upto_eval
+            if stop_at is not None and (upto_eval == 0 or t_eval[upto_eval - 1] != stop_at):
+                times.append(np.array([stop_at]))
+                states.append(end[4](stop_at)[None, :])
+                stored += 1
+        if G is not None and 0 <= last_row < acc:
+            g_old = G[last_row]
+        recent = history[:len(recent) + keep][-PROJECTION_STEPS:]
+        if end:
+            failure = None if end[2] == "terminal" else end[3] if end[2] != "event" else None
+            if end[2] == "event":
+                r = end[0]
+                try:
+                    _event_values(events, model, T[r], Y[r])
+                except NonFiniteError as exc:
+                    failure = _describe_failure(model, exc, T[r], Y[r])
+            nfev_kept = int(out_nfev[end[0]])
+        else:
+            nfev_kept = int(nfev[0])
+            if keep:
+                t = T[-1]
+        if progress is not None:
+            last_t = times[-1][-1] if len(times) and len(times[-1]) else t
+            progress(last_t)
+        if end:
+            rhs.evaluations = start_evaluations + nfev_kept
+            break
+        rhs.evaluations = start_evaluations + int(nfev[0])
+        if status:
+            if status == 4:
+                failure = (f"integrator {integrator} failed at t={t:.6g}: Required step size "
+                           "is less than spacing between numbers.. Loosen rtol/atol, or try "
+                           "an implicit method (Radau, BDF) if the model is stiff")
+            else:
+                try:
+                    model.state_derivative(fail[0], fail[1:])
+                    exc = _LOOP_STATUS[status](model)
+                except (NonFiniteError, SingularMassMatrixError) as raised:
+                    exc = raised
+                failure = _describe_failure(model, exc, t, y)
+            break
+        if t < t_end:
+            failure = _over_budget(budget, steps, stored, t, t_end, h=H[-1] if acc else None)
+    info = {"steps": steps, "njev": 0, "nlu": 0,
+            "solver_rhs_evaluations": rhs.evaluations, "compiled": True}
+    if failure is not None:
+        info["failure"] = failure
+    ts = np.concatenate(times) if times else np.empty(0)
+    ys = np.vstack(states) if states else np.empty((0, n))
+    if not len(ts):
+        ts, ys = np.array([t]), y[None, :].copy()
+    return ts, ys, found, info
 
 
 def _fixed_chunks(rhs, integrator, t0, t_end, y0, dt, compiled, events=()):

@@ -1,0 +1,90 @@
+"""A small stack machine for expressions of time in compiled code (the drives' ``q(t)``,
+``q'(t)``, ``q''(t)``).
+
+A program is a row range of ``ops`` (``(opcode, argument)`` pairs, postfix order) over the
+constants ``consts``; ``mbdyn.programs`` writes them from sympy expressions.  Opcodes:
+``CONST k`` pushes ``consts[k]``, ``TIME`` pushes ``t``, ``ADD n``/``MUL n`` replace the top
+``n`` values by their sum/product, ``POW`` replaces ``base, exponent`` by the power, the
+others apply a function of one value (``ATAN2`` of two) to the top.
+"""
+import numpy as np
+from numba import njit
+
+(CONST, TIME, ADD, MUL, POW, SIN, COS, TAN, EXP, LOG, ASIN, ACOS, ATAN, SINH, COSH, TANH,
+ ABS, ATAN2) = range(18)
+#: the deepest stack a program may need
+STACK = 64
+
+
+@njit(cache=True)
+def evaluate(ops, consts, first, last, t, stack):
+    """The value at ``t`` of the program ``ops[first:last]`` (``stack``: scratch space of
+    ``STACK`` values)."""
+    top = 0
+    for k in range(first, last):
+        op = ops[k, 0]
+        arg = ops[k, 1]
+        if op == CONST:
+            stack[top] = consts[arg]
+            top += 1
+        elif op == TIME:
+            stack[top] = t
+            top += 1
+        elif op == ADD:
+            acc = 0.0
+            for j in range(top - arg, top):
+                acc += stack[j]
+            top -= arg
+            stack[top] = acc
+            top += 1
+        elif op == MUL:
+            acc = 1.0
+            for j in range(top - arg, top):
+                acc *= stack[j]
+            top -= arg
+            stack[top] = acc
+            top += 1
+        elif op == POW:
+            top -= 1
+            stack[top - 1] = stack[top - 1] ** stack[top]
+        elif op == ATAN2:
+            top -= 1
+            stack[top - 1] = np.arctan2(stack[top - 1], stack[top])
+        else:
+            x = stack[top - 1]
+            if op == SIN:
+                x = np.sin(x)
+            elif op == COS:
+                x = np.cos(x)
+            elif op == TAN:
+                x = np.tan(x)
+            elif op == EXP:
+                x = np.exp(x)
+            elif op == LOG:
+                x = np.log(x) if x >= 0.0 else np.nan
+            elif op == ASIN:
+                x = np.arcsin(x)
+            elif op == ACOS:
+                x = np.arccos(x)
+            elif op == ATAN:
+                x = np.arctan(x)
+            elif op == SINH:
+                x = np.sinh(x)
+            elif op == COSH:
+                x = np.cosh(x)
+            elif op == TANH:
+                x = np.tanh(x)
+            else:
+                x = abs(x)
+            stack[top - 1] = x
+    return stack[0]
+
+
+@njit(cache=True, inline="always")
+def drive_values(ops, consts, starts, t, stack, out):
+    """``out[d] = (q, q', q'')`` of every drive ``d`` at ``t``: programs ``3 d .. 3 d + 2``
+    (``starts[k] .. starts[k + 1]`` their rows)."""
+    for d in range(out.shape[0]):
+        for p in range(3):
+            k = 3 * d + p
+            out[d, p] = evaluate(ops, consts, starts[k], starts[k + 1], t, stack)
