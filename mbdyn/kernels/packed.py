@@ -159,17 +159,24 @@ def jourdain_accelerations_packed(fb, ib, t, q, u):
 def state_derivative_packed(fb, ib, t, y, ydot):
     """``ydot = [N(q) u, u']`` for ``y = [q, u]``.  Returns -1, the pivot where the
     Cholesky factorization of ``M`` broke down, or -2 when ``ydot`` holds NaN or Inf."""
-    nq, nu = t[7], t[1]
+    nq = t[7]
     _scatter(fb, ib, t, y[:nq], y[nq:])
     tree, body, state, loads, _, motion, jourdain, _, _ = _views(fb, ib, t)
     pivot = jourdain_accelerations(*tree, *body, *state, *loads, *motion, *jourdain)
     if pivot >= 0:
         return pivot
-    ud = jourdain[3]
+    return _state_rates(fb, ib, t, y, ydot)
+
+
+@njit(cache=True, inline="always")
+def _state_rates(fb, ib, t, y, ydot):
+    """After an evaluation left ``u'`` in the ``ud`` view: ``ydot = [N(q) u, u']``;
+    returns -1, or -2 when ``ydot`` holds NaN or Inf."""
+    nq, nu = t[7], t[1]
+    ud = c_view(fb, t[UD], (nu,))
     for k in range(nu):
         ydot[nq + k] = ud[k]
-    coordinate_rates(y[:nq], y[nq:], c_view(ib, t[SLOTS], (t[8], 5)),
-                     ydot[:nq])
+    coordinate_rates(y[:nq], y[nq:], c_view(ib, t[SLOTS], (t[8], 5)), ydot[:nq])
     for k in range(ydot.shape[0]):
         if not np.isfinite(ydot[k]):
             return -2
@@ -205,19 +212,11 @@ def articulated_accelerations_packed(fb, ib, t, q, u):
 @njit(cache=True)
 def state_derivative_articulated_packed(fb, ib, t, y, ydot):
     """``state_derivative_packed`` with ``u'`` by the articulated-body algorithm."""
-    nq, nu = t[7], t[1]
+    nq = t[7]
     pivot = articulated_accelerations_packed(fb, ib, t, y[:nq], y[nq:])
     if pivot >= 0:
         return pivot
-    ud = fb[t[UD]:t[UD] + nu]
-    for k in range(nu):
-        ydot[nq + k] = ud[k]
-    coordinate_rates(y[:nq], y[nq:], c_view(ib, t[SLOTS], (t[8], 5)),
-                     ydot[:nq])
-    for k in range(ydot.shape[0]):
-        if not np.isfinite(ydot[k]):
-            return -2
-    return -1
+    return _state_rates(fb, ib, t, y, ydot)
 
 
 @njit(cache=True)
