@@ -281,6 +281,8 @@ class Model:
         self._pA, self._cb, self._acc = np.zeros((n, 6)), np.zeros((n, 6)), np.zeros((n, 6))
         self._Dl, self._W = np.zeros((n, 6, 7)), np.zeros((n, 6))
         self._lam = np.zeros(len(rj))
+        #: every temporary of an evaluation (``kernels.evaluate.scratch_size``)
+        self._scratch = np.zeros(ke.scratch_size(n, self.nu, nuf))
         self._slots = np.array(self._free_joint_slots, np.int64).reshape(-1, 5)
         self._pack()
         #: (load name, the row of the load array its function fills, the function)
@@ -588,21 +590,22 @@ class Model:
             self._udfull[self._free_u] = ud
         ke.kinematics_and_loads(*self._tree, self._mass, self._com, self.gravity,
                                 self._qfull, self._ufull, self._udfull, *self._loads_arrays,
-                                *self._kin_out)
+                                *self._kin_out, self._scratch)
         return q, u
 
     def _drop_velocity_products(self):
         """With the gyroscopic effect off: bias accelerations without velocity products."""
         if not self.gyroscopic:
             ke.drop_velocity_products(*self._tree, self._qfull, self._ufull, self._udfull,
-                                      *self._kin_out[:8])
+                                      *self._kin_out[:8], self._scratch)
 
     def _jourdain_terms(self, q, u, t):
         q, u = self._kinematics_kernel(q, u, t)
         self._drop_velocity_products()
-        kd.jourdain(self._mass, self._com, self._inertia, self._has_inertia, self._R, self._r,
-                    self._w, self._alpha, self._a, self._JR, self._JT, self._anc_ptr,
-                    self._anc_idx, self._parent, self._F, self._N, self._M, self._f)
+        kd.jourdain_terms(self._mass, self._com, self._inertia, self._has_inertia, self._R,
+                          self._r, self._w, self._alpha, self._a, self._JR, self._JT,
+                          self._anc_ptr, self._anc_idx, self._parent, self._F, self._N,
+                          self._M, self._f, self._scratch)
         return q, u
 
     # ------------------------------------------------------------------ public numerics
@@ -959,7 +962,7 @@ class Model:
         acc = np.zeros(2)
         kf.force_elements(self._force_int, self._force_data, self._parent, self._axis,
                           self._com, self._qfull, self._ufull, self._R, self._r, self._w,
-                          self._v, self._F, self._N, acc)
+                          self._v, self._F, self._N, acc, self._scratch)
         return float(acc[0]), float(acc[1])
 
     def load_power(self, q, u, t=0.0):
@@ -1024,9 +1027,9 @@ class Model:
               self._alpha, self._a, self._JR, self._JT, self._F, self._N)
         tree = self._tree
         if method == "jourdain":
-            ws += (self._M, self._f, self._L)
+            ws += (self._M, self._f, self._L, self._scratch)
         elif method == "articulated":
-            ws += (self._IA, self._pA, self._cb, self._U, self._Dl, self._acc)
+            ws += (self._IA, self._pA, self._cb, self._U, self._Dl, self._acc, self._scratch)
             tree = tree[:9] + (self._own_ptr, self._own_idx)
         else:
             raise ModelError(f"loop_arguments: no compiled loop for method {method!r}")

@@ -24,10 +24,15 @@ a child's wrench back to the parent.  The velocity-product and drive parts of th
 accelerations enter through the kinematics' bias accelerations (computed with free
 ``u' = 0``): ``A_i = X A_p + S_i u'_i + c_i`` with ``c_i = A_bias_i - X A_bias_p``.
 """
-import numpy as np
+import math
+
 from numba import njit
 
 from .joints import NU
+from .views import UNCOUNTED, c_view
+
+#: floats of scratch ``articulated_body`` needs (``joint_wrenches_tree`` needs 6)
+ARTICULATED_WORK = 51
 
 
 @njit(cache=True, inline="always")
@@ -86,9 +91,9 @@ def _add_shifted_inertia(IA, i, p, rho, Y):
         IA[p, 5, col] += l2
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a_b, JR, JT,
-                     F, N, IA, pA, cb, U, Dl, acc, ud):
+                     F, N, IA, pA, cb, U, Dl, acc, ud, work):
     """Forward dynamics ``ud`` by the articulated-body algorithm (see the module
     docstring), from the kinematics of ``forward_kinematics`` evaluated with ``u' = 0`` for
     the free speeds (bias accelerations ``alpha_b``, ``a_b``; only the frames' own columns
@@ -103,14 +108,13 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
     ``W_i = Ia_i X_i A_p + pa_i`` (``joint_reactions``).
 
     Returns -1, or the first speed column where ``D`` is not positive definite (a degree
-    of freedom without inertia).
+    of freedom without inertia).  ``work``: ``ARTICULATED_WORK`` floats of scratch.
     """
     n = mass.shape[0]
-    Iw = np.empty((3, 3))
-    Y = np.empty((6, 3))
-    tmp = np.empty(24)                   # the vector temporaries share one allocation
-    c, wc, t1, t2 = tmp[0:3], tmp[3:6], tmp[6:9], tmp[9:12]
-    rho, v6, wv = tmp[12:15], tmp[15:21], tmp[21:24]
+    Iw, Y = c_view(work, 0, (3, 3)), c_view(work, 9, (6, 3))
+    c, wc, t1, t2 = (c_view(work, 27, (3,)), c_view(work, 30, (3,)), c_view(work, 33, (3,)),
+                     c_view(work, 36, (3,)))
+    rho, v6, wv = c_view(work, 39, (3,)), c_view(work, 42, (6,)), c_view(work, 48, (3,))
     # -- every body on its own: spatial inertia, velocity-product and applied wrench
     for i in range(n):
         for a_ in range(3):
@@ -187,7 +191,7 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
                         if not s > 0.0:
                             return col0 + j
                         largest = max(largest, s)
-                        Dl[i, j, j] = np.sqrt(s)
+                        Dl[i, j, j] = math.sqrt(s)
                     else:
                         Dl[i, j, m] = s / Dl[i, m, m]
             # the joint's own equations: S^T (IA A + pA) = 0  ->  u' = D^-1 (uv - U^T X A_p)
@@ -291,17 +295,18 @@ def _cholesky_solve_small(Dl, f, k, x):
         x[i] = s / Dl[f, i, i]
 
 
-@njit(cache=True)
-def joint_wrenches_tree(parent, r, IA, pA, acc, out):
+@njit(**UNCOUNTED)
+def joint_wrenches_tree(parent, r, IA, pA, acc, out, work):
     """The wrench each joint's parent exerts on its child, about the child's origin
     (world components), ``out[i] = (force, moment)``, after ``articulated_body``:
     ``W_i = Ia_i X_i A_p + pa_i`` -- the back-substitution of the tree-order elimination.
     """
     n = parent.shape[0]
-    v = np.empty(6)
+    v = c_view(work, 0, (6,))
     for i in range(n):
         p = parent[i]
-        v[:] = 0.0
+        for k in range(6):
+            v[k] = 0.0
         if p >= 0:
             rx, ry, rz = r[i, 0] - r[p, 0], r[i, 1] - r[p, 1], r[i, 2] - r[p, 2]
             v[0], v[1], v[2] = acc[p, 0], acc[p, 1], acc[p, 2]
@@ -319,7 +324,7 @@ def joint_wrenches_tree(parent, r, IA, pA, acc, out):
                 out[i, a_ - 3] = s
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def reaction_components(R, react_joint, react_force, react_moment, wrench, lam):
     """The reaction unknowns ``lambda_k`` of the Newton-Euler system from the joint
     wrenches: component k is the wrench of its joint (the child frame is

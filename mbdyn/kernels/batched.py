@@ -14,11 +14,12 @@ from .integrators import fixed_step_loop
 
 @njit(cache=True)
 def _own_workspace(ws):
-    """A private copy of the 16 workspace arrays of ``Model.loop_arguments``."""
+    """A private copy of the 17 workspace arrays of ``Model.loop_arguments`` (the
+    Jourdain layout; the last is the evaluations' scratch)."""
     return (ws[0].copy(), ws[1].copy(), ws[2].copy(), ws[3].copy(), ws[4].copy(),
             ws[5].copy(), ws[6].copy(), ws[7].copy(), ws[8].copy(), ws[9].copy(),
             ws[10].copy(), ws[11].copy(), ws[12].copy(), ws[13].copy(), ws[14].copy(),
-            ws[15].copy())
+            ws[15].copy(), ws[16].copy())
 
 
 @njit(cache=True, parallel=True)

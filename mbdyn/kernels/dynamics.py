@@ -7,23 +7,25 @@ force ``F[i]`` and moment ``N[i]``.
 """
 import numpy as np
 from numba import njit
+from numba.extending import register_jitable
 
 from .kinematics import cross
 from .linalg3 import cross_to, mat_vec, rotate_tensor
-from .views import c_view
+from .views import UNCOUNTED, c_view
 
 
 @njit(cache=True, inline="always")
 def applied_loads(mass, com, gravity, R, r, load_body, load_point, load_force, load_moment,
-                  load_in_body, F, N):
+                  load_in_body, F, N, work):
     """Gravity and point loads reduced to each centre of mass (world components).
 
     A load's force acts at ``load_point`` (body components); ``load_in_body`` says whether
-    its force and moment are given in body (1) or world (0) components.
+    its force and moment are given in body (1) or world (0) components.  ``work``: at
+    least 15 floats of scratch.
     """
     n = mass.shape[0]
-    tmp = np.empty(15)                  # one allocation for the temporaries
-    f, mo, arm, lever, t = tmp[0:3], tmp[3:6], tmp[6:9], tmp[9:12], tmp[12:15]
+    f, mo, arm = c_view(work, 0, (3,)), c_view(work, 3, (3,)), c_view(work, 6, (3,))
+    lever, t = c_view(work, 9, (3,)), c_view(work, 12, (3,))
     for i in range(n):
         for k in range(3):
             F[i, k] = mass[i] * gravity[k]
@@ -85,15 +87,21 @@ def jourdain(mass, com, inertia, has_inertia, R, r, w, alpha_b, a_b, JR, JT, anc
     composite-rigid-body algorithm, ``composite_mass_matrix``) and
     ``f = sum JT^T (F - m a_bias) + JR^T (N - I alpha_bias - w x I w)``."""
     n, nu = mass.shape[0], M.shape[0]
-    _jourdain(mass, com, inertia, has_inertia, R, r, w, alpha_b, a_b, JR, JT, anc_ptr,
-              anc_idx, parent, F, N, M, f, np.empty(39 * n + 9 * nu + 60))
+    jourdain_terms(mass, com, inertia, has_inertia, R, r, w, alpha_b, a_b, JR, JT, anc_ptr,
+                   anc_idx, parent, F, N, M, f, np.empty(jourdain_work(n, nu)))
 
 
-@njit(cache=True)
-def _jourdain(mass, com, inertia, has_inertia, R, r, w, alpha_b, a_b, JR, JT, anc_ptr,
-              anc_idx, parent, F, N, M, f, work):
-    """``jourdain`` with its scratch in ``work`` (one allocation instead of ten; the views
-    are untracked, ``views.c_view``)."""
+@register_jitable
+def jourdain_work(n, nu):
+    """Floats of scratch ``jourdain_terms`` needs for ``n`` frames and ``nu`` speeds."""
+    return 39 * n + 9 * nu + 60
+
+
+@njit(**UNCOUNTED)
+def jourdain_terms(mass, com, inertia, has_inertia, R, r, w, alpha_b, a_b, JR, JT, anc_ptr,
+                   anc_idx, parent, F, N, M, f, work):
+    """``jourdain`` in the scratch ``work`` (``jourdain_work(n, nu)`` floats): it
+    allocates nothing, so that it can run uncounted (``views.UNCOUNTED``)."""
     n, nu = mass.shape[0], M.shape[0]
     composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc_idx, M,
                           c_view(work, 0, (nu, 6)), c_view(work, 6 * nu, (n, 6, 6)),
@@ -223,9 +231,11 @@ def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc
 LAPACK_CHOLESKY_FROM = 40
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=True)
 def _lapack_cholesky(M, L, tiny):
-    """``L`` from LAPACK's Cholesky; False if it fails or a pivot is below ``tiny``."""
+    """``L`` from LAPACK's Cholesky; False if it fails or a pivot is below ``tiny``.
+    Counted, explicitly (a callee inherits an uncounted caller's mode): LAPACK's factor
+    is allocated and freed in here."""
     try:
         Lf = np.linalg.cholesky(M)
     except Exception:
@@ -239,7 +249,7 @@ def _lapack_cholesky(M, L, tiny):
     return True
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def cholesky_solve(M, f, L, x):
     """Solve ``M x = f`` by Cholesky.  Returns -1, or the index of the first pivot that is
     not positive (the coordinate where positive definiteness fails); ``L`` is workspace."""

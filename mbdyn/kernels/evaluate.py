@@ -2,55 +2,71 @@
 
 Fusing the steps into one compiled call keeps the Python overhead of a right-hand side to a
 single dispatch.  The arguments are the compiled model's static arrays (``tree``, ``body``),
-the joint-space state with drives filled in, the load values and a workspace.
+the joint-space state with drives filled in, the load values and a workspace whose last
+array, ``scratch`` (``scratch_size`` floats), holds every temporary: the evaluations
+allocate nothing and run uncounted (``views.UNCOUNTED``).
 """
 import numpy as np
 from numba import njit
 
-from .articulated import articulated_body, joint_wrenches_tree, reaction_components
-from .dynamics import applied_loads, cholesky_solve, jourdain, newton_euler_system
-from .forces import force_elements
-from .kinematics import forward_kinematics
+from .articulated import (ARTICULATED_WORK, articulated_body, joint_wrenches_tree,
+                          reaction_components)
+from .dynamics import (applied_loads, cholesky_solve, jourdain_terms, jourdain_work,
+                       newton_euler_system)
+from .forces import FORCE_WORK, force_elements
+from .kinematics import KINEMATICS_WORK, walk
+from .views import UNCOUNTED, c_view
 
 
-@njit(cache=True)
+def scratch_size(n, nu, nuf):
+    """Floats of ``scratch`` an evaluation of ``n`` frames, ``nu`` free speeds and ``nuf``
+    joint-space speeds needs.  The steps use it one after another from its start, except
+    the speeds ``drop_velocity_products`` keeps across a second kinematic pass (after the
+    kinematics' part)."""
+    return max(KINEMATICS_WORK + nuf, FORCE_WORK, jourdain_work(n, nu), ARTICULATED_WORK)
+
+
+@njit(**UNCOUNTED)
 def kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                          mass, com, gravity, qfull, ufull, udfull,
                          load_body, load_point, load_force, load_moment, load_in_body,
                          force_int, force_data, switches,
-                         R, r, w, v, alpha, a, JR, JT, F, N):
+                         R, r, w, v, alpha, a, JR, JT, F, N, scratch):
     """Motion of every frame, then the applied loads ``F``, ``N``: gravity, point loads
     and force elements.  ``force_int`` is None for a model without force elements: a type,
     not a count, so that numba prunes the call and compiles no force kernel for it."""
-    forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
-                       qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT)
+    walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull, ufull,
+         udfull, R, r, w, v, alpha, a, JR, JT, scratch)
     applied_loads(mass, com, gravity, R, r, load_body, load_point, load_force, load_moment,
-                  load_in_body, F, N)
+                  load_in_body, F, N, scratch)
     if force_int is not None and force_int.shape[0]:
         force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F,
-                       N, force_data[0:0])
+                       N, force_data[0:0], scratch)
 
 
-@njit(cache=True, inline="always")
+@njit(**UNCOUNTED)
 def drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
-                           qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT):
+                           qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, scratch):
     """The ``gyroscopic`` effect switched off: the motion again with every speed zero, so
     that the bias accelerations keep only the prescribed (drive) accelerations and
     ``w x I w`` vanishes; the applied loads computed before keep the true velocities."""
-    saved = ufull.copy()
-    ufull[:] = 0.0
-    forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
-                       qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT)
-    for k in range(ufull.shape[0]):     # element-wise: see kinematics.forward_kinematics
+    nuf = ufull.shape[0]
+    saved = c_view(scratch, KINEMATICS_WORK, (nuf,))
+    for k in range(nuf):
+        saved[k] = ufull[k]
+        ufull[k] = 0.0
+    walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull, ufull,
+         udfull, R, r, w, v, alpha, a, JR, JT, scratch)
+    for k in range(nuf):
         ufull[k] = saved[k]
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def jourdain_accelerations(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                            mass, com, inertia, has_inertia, gravity, qfull, ufull, udfull,
                            load_body, load_point, load_force, load_moment, load_in_body,
                            force_int, force_data, switches,
-                           R, r, w, v, alpha, a, JR, JT, F, N, M, f, L, ud):
+                           R, r, w, v, alpha, a, JR, JT, F, N, M, f, L, ud, scratch):
     """Kinematics, loads, ``M`` and ``f``, then ``ud = M^-1 f`` by Cholesky.
 
     Returns -1 on success, the index of the speed where the Cholesky factorisation broke
@@ -59,12 +75,14 @@ def jourdain_accelerations(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, an
     kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                          mass, com, gravity, qfull, ufull, udfull,
                          load_body, load_point, load_force, load_moment, load_in_body,
-                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, F, N)
+                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, F, N,
+                         scratch)
     if switches[0] == 0:
         drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr,
-                               anc_idx, qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT)
-    jourdain(mass, com, inertia, has_inertia, R, r, w, alpha, a, JR, JT, anc_ptr, anc_idx,
-             parent, F, N, M, f)
+                               anc_idx, qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT,
+                               scratch)
+    jourdain_terms(mass, com, inertia, has_inertia, R, r, w, alpha, a, JR, JT, anc_ptr,
+                   anc_idx, parent, F, N, M, f, scratch)
     pivot = cholesky_solve(M, f, L, ud)
     if pivot >= 0:
         return pivot
@@ -80,7 +98,7 @@ def newton_euler_solution(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc
                           load_body, load_point, load_force, load_moment, load_in_body,
                           force_int, force_data, switches,
                           react_joint, react_force, react_moment,
-                          R, r, w, v, alpha, a, JR, JT, F, N, A, b):
+                          R, r, w, v, alpha, a, JR, JT, F, N, A, b, scratch):
     """Kinematics, loads, the Newton-Euler system with reactions, solved by LU.
 
     Returns the unknowns ``x = [ud, lambda]`` (a new array).
@@ -88,21 +106,24 @@ def newton_euler_solution(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc
     kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                          mass, com, gravity, qfull, ufull, udfull,
                          load_body, load_point, load_force, load_moment, load_in_body,
-                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, F, N)
+                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, F, N,
+                         scratch)
     if switches[0] == 0:
         drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr,
-                               anc_idx, qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT)
+                               anc_idx, qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT,
+                               scratch)
     newton_euler_system(mass, com, inertia, parent, R, r, w, alpha, a, JR, JT, anc_ptr, anc_idx,
                         F, N, react_joint, react_force, react_moment, A, b)
     return np.linalg.solve(A, b)
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def articulated_accelerations(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr,
                               own_idx, mass, com, inertia, gravity, qfull, ufull, udfull,
                               load_body, load_point, load_force, load_moment, load_in_body,
                               force_int, force_data, switches,
-                              R, r, w, v, alpha, a, JR, JT, F, N, IA, pA, cb, U, Dl, acc, ud):
+                              R, r, w, v, alpha, a, JR, JT, F, N, IA, pA, cb, U, Dl, acc, ud,
+                              scratch):
     """Kinematics, loads, then ``ud`` by the articulated-body algorithm: O(n).
 
     ``own_ptr``/``own_idx`` list each frame's own speed columns only (in place of the
@@ -113,12 +134,14 @@ def articulated_accelerations(parent, kind, axis, seq, pos, C, qoff, uoff, ucol,
     kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr, own_idx,
                          mass, com, gravity, qfull, ufull, udfull,
                          load_body, load_point, load_force, load_moment, load_in_body,
-                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, F, N)
+                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, F, N,
+                         scratch)
     if switches[0] == 0:
         drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr,
-                               own_idx, qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT)
+                               own_idx, qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT,
+                               scratch)
     pivot = articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha, a, JR, JT,
-                             F, N, IA, pA, cb, U, Dl, acc, ud)
+                             F, N, IA, pA, cb, U, Dl, acc, ud, scratch)
     if pivot >= 0:
         return pivot
     for k in range(ud.shape[0]):
@@ -127,13 +150,13 @@ def articulated_accelerations(parent, kind, axis, seq, pos, C, qoff, uoff, ucol,
     return -1
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def newton_euler_tree(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr, own_idx,
                       mass, com, inertia, gravity, qfull, ufull, udfull,
                       load_body, load_point, load_force, load_moment, load_in_body,
                       force_int, force_data, switches, react_joint, react_force, react_moment,
                       R, r, w, v, alpha, a, JR, JT, F, N, IA, pA, cb, U, Dl, acc, wrench, ud,
-                      lam):
+                      lam, scratch):
     """The Newton-Euler equations with reaction unknowns solved in tree order: speed rates
     ``ud`` and reaction components ``lam`` (as ``newton_euler_solution``'s ``x``), in O(n).
     Returns as ``articulated_accelerations`` (-2 also for non-finite reactions)."""
@@ -142,10 +165,10 @@ def newton_euler_tree(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr
                                       ufull, udfull, load_body, load_point, load_force,
                                       load_moment, load_in_body, force_int, force_data,
                                       switches, R, r, w, v, alpha, a, JR, JT, F, N, IA, pA, cb,
-                                      U, Dl, acc, ud)
+                                      U, Dl, acc, ud, scratch)
     if pivot != -1:
         return pivot
-    joint_wrenches_tree(parent, r, IA, pA, acc, wrench)
+    joint_wrenches_tree(parent, r, IA, pA, acc, wrench, scratch)
     reaction_components(R, react_joint, react_force, react_moment, wrench, lam)
     for k in range(lam.shape[0]):
         if not np.isfinite(lam[k]):

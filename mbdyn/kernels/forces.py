@@ -22,19 +22,20 @@ the power of its non-conservative part (what dampers and friction take out, nega
 """
 import math
 
-import numpy as np
 from numba import njit
 
 from .linalg3 import cross_to, mat_t_vec, mat_vec
+from .views import UNCOUNTED
 
 SPRING_DAMPER, JOINT_SPRING_DAMPER, BUSHING, BEARING, CONTACT_SPHERE, CONTACT_DISK = 1, 2, 3, 4, 5, 6
 KIND_CODES = {"spring-damper": SPRING_DAMPER, "joint-spring-damper": JOINT_SPRING_DAMPER,
               "bushing": BUSHING, "bearing": BEARING, "contact": CONTACT_SPHERE}
 NO_TABLE, LINEAR, PCHIP, LAW = 0, 1, 2, 3      # LAW: a law evaluated in Python, given as preload
 ROW = 10          # entries of a force_int row
+FORCE_WORK = 74   # floats of scratch ``force_elements`` needs
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def table_eval(data, off, mode, x, out):
     """Interpolated value, slope and integral (from the first knot) at ``x`` into
     ``out[0:3]``."""
@@ -81,7 +82,7 @@ def table_eval(data, off, mode, x, out):
                                  + (-0.5 * s4 + s3) * y1 + (0.25 * s4 - s3 / 3) * d1)
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def _point(i, s, R, r, w, v, p, pv, lever):
     """World position ``p`` and velocity ``pv`` of the point ``s`` (frame components) of
     frame ``i``; the ground (-1) holds still and its components are world ones."""
@@ -97,7 +98,7 @@ def _point(i, s, R, r, w, v, p, pv, lever):
         pv[k] += v[i, k]
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def _material_velocity(i, p, r, w, v, out, lever):
     """Velocity of the material point of frame ``i`` at the world point ``p``."""
     if i < 0:
@@ -110,7 +111,7 @@ def _material_velocity(i, p, r, w, v, out, lever):
         out[k] += v[i, k]
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def _apply(i, p, f, m, sign, R, r, com, F, N, lever, t):
     """Add ``sign * f`` acting at the world point ``p`` and the moment ``sign * m`` to
     frame ``i``'s loads (reduced to its centre of mass)."""
@@ -125,7 +126,7 @@ def _apply(i, p, f, m, sign, R, r, com, F, N, lever, t):
         N[i, k] += sign * (t[k] + m[k])
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def _law(data, spring_off, spring_mode, damper_off, damper_mode, k, c, F0, x, xd, tmp):
     """Tension of a spring-damper law and the potential of its spring part:
     ``(spring force, damper force, potential)``."""
@@ -149,16 +150,16 @@ def _law(data, spring_off, spring_mode, damper_off, damper_mode, k, c, F0, x, xd
     return fs, fd, V
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F, N,
-                   acc):
+                   acc, work):
     """Add every force element's wrenches to ``F``, ``N``; with ``acc.shape[0] >= 2`` also
-    their potential energy (``acc[0]``) and non-conservative power (``acc[1]``)."""
+    their potential energy (``acc[0]``) and non-conservative power (``acc[1]``).
+    ``work``: at least ``FORCE_WORK`` floats of scratch."""
     want = acc.shape[0] >= 2
-    tmp = np.empty(48)
+    tmp, six = work[0:48], work[48:FORCE_WORK]
     pa, pb, va, vb, d, f = tmp[0:3], tmp[3:6], tmp[6:9], tmp[9:12], tmp[12:15], tmp[15:18]
     m, lever, t, e1, e2, tab = tmp[18:21], tmp[21:24], tmp[24:27], tmp[27:30], tmp[30:33], tmp[33:36]
-    six = np.empty(26)
     x6, xd6, w6, ks = six[0:6], six[6:12], six[12:18], six[18:26]
     zero = tmp[36:39]
     zero[:] = 0.0
@@ -279,7 +280,7 @@ def force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r,
                      pa, va, d, f, lever, t, e1, zero)
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def _to_world(i, R, s, out):
     if i < 0:
         for k in range(3):      # element-wise: an array assignment compiles numba's message
@@ -288,7 +289,7 @@ def _to_world(i, R, s, out):
         mat_vec(R[i], s, out)
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def _bushing_state(ia, ib, R, w, d, va, vb, x6, xd6, t1, t2, t3, t4):
     """Relative translation and small rotation of frame b in frame a's axes, and their
     rates (``d`` = world offset b - a; ``va``, ``vb`` the points' velocities)."""
@@ -330,7 +331,7 @@ def _bushing_state(ia, ib, R, w, d, va, vb, x6, xd6, t1, t2, t3, t4):
         xd6[3 + q] = t2[q]
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def _contact(kind, i, off, data, R, r, w, v, com, F, N, acc, want, pc, vc, n, f, lever, t,
              ax, zero):
     """Compliant contact of a sphere (or a disk's rim) of frame ``i`` with a plane fixed

@@ -43,24 +43,25 @@ def accelerations(tree, body, loads, ws, ud):
 
 @overload(accelerations, inline="always")
 def _accelerations_route(tree, body, loads, ws, ud):
-    """The formulation is chosen when the loop is compiled, by the workspace's type: 16
-    arrays (``M``, ``f``, ``L`` last) for ``M u' = f``, 19 (the articulated-body
-    workspace last; ``tree`` then lists each frame's own speed columns) for the
-    articulated-body algorithm.  A run compiles only its own route."""
-    if len(ws) == 16:
+    """The formulation is chosen when the loop is compiled, by the workspace's type: 17
+    arrays (``M``, ``f``, ``L``, scratch last) for ``M u' = f``, 20 (the articulated-body
+    workspace, then the scratch; ``tree`` then lists each frame's own speed columns) for
+    the articulated-body algorithm.  A run compiles only its own route."""
+    if len(ws) == 17:
         def jourdain_route(tree, body, loads, ws, ud):
-            (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, F, N, M, f, L) = ws
+            (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, F, N, M, f, L, scratch) = ws
             return jourdain_accelerations(*tree, *body, qfull, ufull, udfull, *loads,
-                                          R, r, w, v, alpha, a, JR, JT, F, N, M, f, L, ud)
+                                          R, r, w, v, alpha, a, JR, JT, F, N, M, f, L, ud,
+                                          scratch)
         return jourdain_route
 
     def articulated_route(tree, body, loads, ws, ud):
         (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, F, N, IA, pA, cb, U, Dl,
-         acc) = ws
+         acc, scratch) = ws
         mass, com, inertia, _, gravity = body
         return articulated_accelerations(*tree, mass, com, inertia, gravity, qfull, ufull,
                                          udfull, *loads, R, r, w, v, alpha, a, JR, JT, F, N,
-                                         IA, pA, cb, U, Dl, acc, ud)
+                                         IA, pA, cb, U, Dl, acc, ud, scratch)
     return articulated_route
 
 

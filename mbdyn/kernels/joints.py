@@ -16,6 +16,7 @@ import numpy as np
 from numba import njit
 
 from .linalg3 import cross_to, mat_mat, mat_t_vec
+from .views import UNCOUNTED
 
 FIXED, REVOLUTE, PRISMATIC, EULER, SPHERICAL, FREE = 0, 1, 2, 3, 4, 5
 KIND_CODES = {"fixed": FIXED, "revolute": REVOLUTE, "prismatic": PRISMATIC,
@@ -27,7 +28,7 @@ NU = (0, 1, 1, 3, 3, 6)
 MAX_NU = 6
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def rotation_about_axis(axis, angle, out):
     """Rodrigues: rotation by ``angle`` about the unit ``axis``; maps rotated to fixed comps."""
     c = np.cos(angle)
@@ -45,7 +46,7 @@ def rotation_about_axis(axis, angle, out):
     out[2, 2] = c + z * z * k
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def rotation_about_coordinate_axis(k, angle, out):
     """Rotation by ``angle`` about coordinate axis ``k`` (0=x, 1=y, 2=z); = T_k(angle)^T."""
     c = np.cos(angle)
@@ -60,7 +61,7 @@ def rotation_about_coordinate_axis(k, angle, out):
     out[j, i] = s
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def quaternion_to_matrix(q, out):
     """Rotation matrix of the quaternion ``q = (w, x, y, z)``, normalised first.
 
@@ -80,7 +81,7 @@ def quaternion_to_matrix(q, out):
     out[2, 2] = 1.0 - 2.0 * (x * x + y * y)
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def quaternion_rate(q, w, out):
     """``q' = 1/2 q (x) (0, w)`` with ``w`` in the rotated (child) frame.
 
@@ -95,7 +96,7 @@ def quaternion_rate(q, w, out):
     out[3] = 0.5 * (-c * w[0] + b * w[1] + a * w[2])
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def euler_rate_matrix(seq, angles, rates, Hw, hw, Sm, Sv):
     """Relative angular velocity of an Euler-angle joint, child components.
 
@@ -132,7 +133,7 @@ def euler_rate_matrix(seq, angles, rates, Hw, hw, Sm, Sv):
         hw[k] = dc0 * rates[0] + dc1 * rates[1]
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def joint_motion(kind, axis, seq, qj, uj, Rrel, d, Hw, Hv, hw, hv, Sm, Sv):
     """Relative motion of one joint; see the module docstring for the outputs.
     ``Sm`` (4x3x3) and ``Sv`` (8x3) are scratch."""
@@ -177,7 +178,7 @@ def joint_motion(kind, axis, seq, qj, uj, Rrel, d, Hw, Hv, hw, hv, Sm, Sv):
             Hw[k, 3 + k] = 1.0
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def joint_coordinate_rates(kind, qj, uj, out):
     """Kinematic equations ``q' = N(q) u`` of one joint."""
     if kind == SPHERICAL:
@@ -191,7 +192,7 @@ def joint_coordinate_rates(kind, qj, uj, out):
             out[k] = uj[k]
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def coordinate_rates(q, u, slots, out):
     """``q' = N(q) u`` for every free joint; ``slots[s] = (kind, q start, nq, u start, nu)``."""
     for s in range(slots.shape[0]):

@@ -18,7 +18,7 @@ from numba import njit
 
 from .joints import MAX_NU, joint_motion
 from .linalg3 import cross_to, mat_mat, mat_vec
-from .views import c_view
+from .views import UNCOUNTED, c_view
 
 
 @njit(cache=True)
@@ -29,7 +29,7 @@ def cross(a, b):
                      a[0] * b[1] - a[1] * b[0]))
 
 
-#: floats of scratch ``forward_kinematics`` needs (see ``_walk``)
+#: floats of scratch ``forward_kinematics`` needs (see ``walk``)
 KINEMATICS_WORK = 5 * 9 + 2 * 3 * MAX_NU + 4 * 9 + 8 * 3 + 25 * 3 + 1
 
 
@@ -42,16 +42,15 @@ def forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_pt
     depends (its own joint's and its ancestors'); the other columns of ``JR[i]`` and
     ``JT[i]`` are zero and are never written, so the caller zeroes them once.
     """
-    _walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull, ufull,
-          udfull, R, r, w, v, alpha, a, JR, JT, np.empty(KINEMATICS_WORK),
-          np.empty(3, np.int64))
+    walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull, ufull,
+         udfull, R, r, w, v, alpha, a, JR, JT, np.empty(KINEMATICS_WORK))
 
 
-@njit(cache=True)
-def _walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull, ufull,
-          udfull, R, r, w, v, alpha, a, JR, JT, work, seqi):
-    """``forward_kinematics`` with its scratch ``work`` (``KINEMATICS_WORK`` floats, one
-    allocation instead of a dozen) and ``seqi`` (3 integers)."""
+@njit(**UNCOUNTED)
+def walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull, ufull,
+         udfull, R, r, w, v, alpha, a, JR, JT, work):
+    """``forward_kinematics`` in the scratch ``work`` (at least ``KINEMATICS_WORK``
+    floats): it allocates nothing, so that it can run uncounted (``views.UNCOUNTED``)."""
     n = parent.shape[0]
     # Per-frame rows are copied into this scratch, element by element, rather than passed
     # on as views (R[p], w[p], ...): each view costs reference-count calls, which cost
@@ -86,11 +85,10 @@ def _walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, q
             udj[k] = udfull[j0 + k]
         for k in range(3):
             axi[k] = axis[i, k]
-            seqi[k] = seq[i, k]
             posi[k] = pos[i, k]
             for m in range(3):
                 Ci[k, m] = C[i, k, m]
-        joint_motion(kd, axi, seqi, qj[:nq], uj[:nu], Rrel, d, Hw, Hv, hw, hv, Sm, Sv)
+        joint_motion(kd, axi, seq[i], qj[:nq], uj[:nu], Rrel, d, Hw, Hv, hw, hv, Sm, Sv)
 
         # orientation and position: J0 = parent (x) placement, child = J0 (x) joint
         if p >= 0:
@@ -178,7 +176,7 @@ def _walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, q
                                      + RJ0[k, 2] * Hv[2, c])
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def point_jacobian(JT_origin, JR, offset_world, out):
     """Translation Jacobian of a point fixed on a frame: ``JT_P = JT_O - [r_OP]x JR``."""
     ncol = JR.shape[1]

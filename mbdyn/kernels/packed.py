@@ -19,25 +19,26 @@ from .evaluate import (articulated_accelerations, jourdain_accelerations, newton
                        newton_euler_tree)
 from .forces import ROW
 from .joints import coordinate_rates
-from .views import c_view, untracked
+from .views import UNCOUNTED, c_view, untracked
 
 #: float arrays in buffer order, with their shapes in terms of the sizes below
 FLOATS = ("gravity", "axis", "pos", "C", "mass", "com", "inertia", "load_point", "load_force",
           "load_moment", "react_force", "react_moment", "qfull", "ufull", "udfull", "R", "r",
           "w", "v", "alpha", "a", "JR", "JT", "F", "N", "M", "f", "L", "A", "b", "ud",
-          "force_data", "IA", "pA", "cb", "U", "Dl", "acc", "W", "lam")
-#: integer arrays in buffer order (the two flag arrays are stored as 0/1)
+          "force_data", "IA", "pA", "cb", "U", "Dl", "acc", "W", "lam", "scratch")
+#: integer arrays in buffer order (the two flags, has_inertia and load_in_body, as 0/1)
 INTS = ("parent", "kind", "seq", "qoff", "uoff", "ucol", "anc_ptr", "anc_idx", "has_inertia",
         "load_body", "load_in_body", "react_joint", "free_q", "free_u", "slots", "force_int",
         "switches", "own_ptr", "own_idx")
 #: sizes, first entries of the offset table: frames, free speeds, loads, joint-space
 #: coordinates and speeds, ancestor-column entries, reaction components, free coordinates,
-#: free joints, force elements, force-element numbers
-SIZES = ("n", "nu", "nl", "nqf", "nuf", "nanc", "nreact", "nq", "nslots", "ne", "nfd")
+#: free joints, force elements, force-element numbers, scratch floats
+SIZES = ("n", "nu", "nl", "nqf", "nuf", "nanc", "nreact", "nq", "nslots", "ne", "nfd",
+         "nscratch")
 
 (GRAVITY, AXIS, POS, C, MASS, COM, INERTIA, LOAD_POINT, LOAD_FORCE, LOAD_MOMENT, REACT_FORCE,
  REACT_MOMENT, QFULL, UFULL, UDFULL, R, RR, W, V, ALPHA, A, JR, JT, F, N, M, FF, L, AA, B,
- UD, FORCE_DATA, IA, PA, CB, U, DL, ACC, WRENCH, LAM) = range(len(SIZES),
+ UD, FORCE_DATA, IA, PA, CB, U, DL, ACC, WRENCH, LAM, SCRATCH) = range(len(SIZES),
                                                                 len(SIZES) + len(FLOATS))
 (PARENT, KIND, SEQ, QOFF, UOFF, UCOL, ANC_PTR, ANC_IDX, HAS_INERTIA, LOAD_BODY, LOAD_IN_BODY,
  REACT_JOINT, FREE_Q, FREE_U, SLOTS, FORCE_INT, SWITCHES, OWN_PTR, OWN_IDX) = range(len(SIZES) + len(FLOATS), len(SIZES) + len(FLOATS) + len(INTS))
@@ -52,7 +53,7 @@ def pack(floats, ints):
              "nuf": floats["ufull"].shape[0], "nanc": ints["anc_idx"].shape[0],
              "nreact": ints["react_joint"].shape[0], "nq": ints["free_q"].shape[0],
              "nslots": ints["slots"].shape[0], "ne": ints["force_int"].shape[0],
-             "nfd": floats["force_data"].shape[0]}
+             "nfd": floats["force_data"].shape[0], "nscratch": floats["scratch"].shape[0]}
     table = np.zeros(len(SIZES) + len(FLOATS) + len(INTS), np.int64)
     table[:len(SIZES)] = [sizes[s] for s in SIZES]
     views = {}
@@ -66,7 +67,7 @@ def pack(floats, ints):
             table[first + k] = at
             view = buf[at:at + arr.size].reshape(arr.shape)
             view[...] = arr
-            views[name] = view if arr.dtype != np.bool_ else arr   # flags keep their bools
+            views[name] = view
             at += arr.size
         if names is FLOATS:
             fbuf = buf
@@ -75,14 +76,14 @@ def pack(floats, ints):
     return fbuf, ibuf, table, views
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def _views(fb, ib, t):
     """Every packed array as a view, in the order of the unpacked kernels' arguments:
     tree (11), body (mass, com, inertia, has_inertia, gravity), joint-space state (3),
     loads (5, then force elements and effect switches: 3), reactions (3), motion (10),
     Jourdain (M, f, L, ud), Newton-Euler (A, b), articulated bodies (the frames' own
     columns ``own_ptr``, ``own_idx``, then the workspace of ``articulated.articulated_body``
-    and the joint wrenches and reaction components).
+    and the joint wrenches and reaction components), and the evaluations' scratch.
     Offsets are read from ``t`` at run time: literal constants as arguments would make
     numba compile a slicing helper per constant."""
     n, nu, nl, nqf, nuf, nanc, nreact = t[0], t[1], t[2], t[3], t[4], t[5], t[6]
@@ -96,14 +97,14 @@ def _views(fb, ib, t):
             ib[t[ANC_PTR]:t[ANC_PTR] + n + 1], ib[t[ANC_IDX]:t[ANC_IDX] + nanc])
     body = (fb[t[MASS]:t[MASS] + n], c_view(fb, t[COM], (n, 3)),
             c_view(fb, t[INERTIA], (n, 3, 3)),
-            ib[t[HAS_INERTIA]:t[HAS_INERTIA] + n] != 0, fb[t[GRAVITY]:t[GRAVITY] + 3])
+            ib[t[HAS_INERTIA]:t[HAS_INERTIA] + n], fb[t[GRAVITY]:t[GRAVITY] + 3])
     state = (fb[t[QFULL]:t[QFULL] + nqf], fb[t[UFULL]:t[UFULL] + nuf],
              fb[t[UDFULL]:t[UDFULL] + nuf])
     loads = (ib[t[LOAD_BODY]:t[LOAD_BODY] + nl],
              c_view(fb, t[LOAD_POINT], (nl, 3)),
              c_view(fb, t[LOAD_FORCE], (nl, 3)),
              c_view(fb, t[LOAD_MOMENT], (nl, 3)),
-             ib[t[LOAD_IN_BODY]:t[LOAD_IN_BODY] + nl] != 0,
+             ib[t[LOAD_IN_BODY]:t[LOAD_IN_BODY] + nl],
              c_view(ib, t[FORCE_INT], (t[9], ROW)),
              fb[t[FORCE_DATA]:t[FORCE_DATA] + t[10]], ib[t[SWITCHES]:t[SWITCHES] + 1])
     reactions = (ib[t[REACT_JOINT]:t[REACT_JOINT] + nreact],
@@ -130,10 +131,12 @@ def _views(fb, ib, t):
                    c_view(fb, t[ACC], (n, 6)),
                    c_view(fb, t[WRENCH], (n, 6)),
                    fb[t[LAM]:t[LAM] + nreact])
-    return tree, body, state, loads, reactions, motion, jourdain, newton_euler, articulated
+    scratch = fb[t[SCRATCH]:t[SCRATCH] + t[11]]
+    return (tree, body, state, loads, reactions, motion, jourdain, newton_euler, articulated,
+            scratch)
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def _scatter(fb, ib, t, q, u):
     """Free coordinates and speeds into the joint-space state; their rates ``u'`` to zero
     (the Jourdain terms are evaluated at ``u' = 0``; driven entries are the caller's)."""
@@ -146,23 +149,23 @@ def _scatter(fb, ib, t, q, u):
         udfull[free_u[k]] = 0.0
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def jourdain_accelerations_packed(fb, ib, t, q, u):
     """Scatter ``q``, ``u``, then ``evaluate.jourdain_accelerations`` on packed arrays (same
     return value; ``u'`` is left in the ``ud`` view)."""
     _scatter(fb, ib, t, q, u)
-    tree, body, state, loads, _, motion, jourdain, _, _ = _views(fb, ib, t)
-    return jourdain_accelerations(*tree, *body, *state, *loads, *motion, *jourdain)
+    tree, body, state, loads, _, motion, jourdain, _, _, scratch = _views(fb, ib, t)
+    return jourdain_accelerations(*tree, *body, *state, *loads, *motion, *jourdain, scratch)
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def state_derivative_packed(fb, ib, t, y, ydot):
     """``ydot = [N(q) u, u']`` for ``y = [q, u]``.  Returns -1, the pivot where the
     Cholesky factorization of ``M`` broke down, or -2 when ``ydot`` holds NaN or Inf."""
     nq = t[7]
     _scatter(fb, ib, t, y[:nq], y[nq:])
-    tree, body, state, loads, _, motion, jourdain, _, _ = _views(fb, ib, t)
-    pivot = jourdain_accelerations(*tree, *body, *state, *loads, *motion, *jourdain)
+    tree, body, state, loads, _, motion, jourdain, _, _, scratch = _views(fb, ib, t)
+    pivot = jourdain_accelerations(*tree, *body, *state, *loads, *motion, *jourdain, scratch)
     if pivot >= 0:
         return pivot
     return _state_rates(fb, ib, t, y, ydot)
@@ -188,28 +191,28 @@ def newton_euler_solution_packed(fb, ib, t, q, u):
     """Scatter ``q``, ``u``, then ``evaluate.newton_euler_solution`` on packed arrays.
     Returns the unknowns ``x = [ud, lambda]`` (a new array) and whether all are finite."""
     _scatter(fb, ib, t, q, u)
-    tree, body, state, loads, reactions, motion, _, newton_euler, _ = _views(fb, ib, t)
+    tree, body, state, loads, reactions, motion, _, newton_euler, _, scratch = _views(fb, ib, t)
     mass, com, inertia, _, gravity = body
     x = newton_euler_solution(*tree, mass, com, inertia, gravity, *state, *loads,
-                              *reactions, *motion, *newton_euler)
+                              *reactions, *motion, *newton_euler, scratch)
     finite = True
     for k in range(x.shape[0]):
         finite = finite and np.isfinite(x[k])
     return x, finite
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def articulated_accelerations_packed(fb, ib, t, q, u):
     """Scatter ``q``, ``u``, then ``evaluate.articulated_accelerations`` on packed arrays
     (same return value; ``u'`` is left in the ``ud`` view)."""
     _scatter(fb, ib, t, q, u)
-    tree, body, state, loads, _, motion, jourdain, _, art = _views(fb, ib, t)
+    tree, body, state, loads, _, motion, jourdain, _, art, scratch = _views(fb, ib, t)
     mass, com, inertia, _, gravity = body
     return articulated_accelerations(*tree[:9], *art[:2], mass, com, inertia, gravity, *state,
-                                     *loads, *motion, *art[2:8], jourdain[3])
+                                     *loads, *motion, *art[2:8], jourdain[3], scratch)
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def state_derivative_articulated_packed(fb, ib, t, y, ydot):
     """``state_derivative_packed`` with ``u'`` by the articulated-body algorithm."""
     nq = t[7]
@@ -219,13 +222,13 @@ def state_derivative_articulated_packed(fb, ib, t, y, ydot):
     return _state_rates(fb, ib, t, y, ydot)
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def newton_euler_tree_packed(fb, ib, t, q, u):
     """Scatter ``q``, ``u``, then ``evaluate.newton_euler_tree`` on packed arrays: ``u'``
     in the ``ud`` view, the reaction components in ``lam``; same return value."""
     _scatter(fb, ib, t, q, u)
-    tree, body, state, loads, reactions, motion, jourdain, _, art = _views(fb, ib, t)
+    tree, body, state, loads, reactions, motion, jourdain, _, art, scratch = _views(fb, ib, t)
     mass, com, inertia, _, gravity = body
     return newton_euler_tree(*tree[:9], *art[:2], mass, com, inertia, gravity, *state, *loads,
-                             *reactions, *motion, *art[2:9], jourdain[3], art[9])
+                             *reactions, *motion, *art[2:9], jourdain[3], art[9], scratch)
 

@@ -11,6 +11,15 @@ from numba.core.imputils import impl_ret_untracked
 from numba.extending import intrinsic
 from numba.np.arrayobj import make_array, populate_array
 
+#: ``njit`` options of the kernels an evaluation runs through: compiled without numba's
+#: reference counting (its ``_nrt=False``).  Every array a compiled function holds --
+#: argument, view, tuple member -- otherwise costs a call to increment its count and one to
+#: decrement it, even when the array is untracked: some 700 calls, half the time of a
+#: double pendulum's evaluation.  Such a kernel must not allocate (``np.empty``, ``copy``,
+#: ``np.linalg``) and must not return an array: it works in the arrays and scratch it is
+#: given, and may call counted kernels that allocate and free inside themselves.
+UNCOUNTED = {"cache": True, "_nrt": False}
+
 
 @intrinsic
 def c_view(typingctx, buf, start, shape):
