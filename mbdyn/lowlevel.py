@@ -1,9 +1,10 @@
 """The low-level entry: the compiled kernels of one model, for users who drive their own
 loops (``Model.lowlevel()``).
 
-Each call is one compiled call on the model's packed buffers after the essential checks
-(the inputs are float64 numpy arrays of the right sizes: anything else would make numba
-compile anew or write past the buffers): no conversion, no copy of the result.
+Each call is one compiled call on the model's packed buffers, with the essential checks
+made there: the entry points are compiled for contiguous, writable float64 arrays only
+(numba refuses any other type at the call instead of compiling for it), and check the
+sizes before they touch the buffers.  No conversion, no copy of the result.
 What it returns is a view into the model's workspace, overwritten by the next evaluation
 of the same model (copy it, or pass ``out=``, to keep it).  Failures raise the same errors
 as ``Model.forward_dynamics`` (a degree of freedom without inertia, NaN or Inf), found
@@ -13,16 +14,57 @@ the ``Model`` methods.  Not thread-safe (one workspace per model).
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from .errors import ModelError
 from .kernels import packed as kp
+from .kernels.views import UNCOUNTED
 
 _ARRAY, _F64 = np.ndarray, np.dtype(np.float64)
 
-#: per-call formulations of the low-level entry
-ROUTES = {"jourdain": (kp.jourdain_accelerations_packed, kp.state_derivative_packed),
-          "articulated": (kp.articulated_accelerations_packed,
-                          kp.state_derivative_articulated_packed)}
+#: the one type the entry points accept: no other is compiled, so that a wrong array is
+#: refused by numba's dispatcher (a TypeError) instead of being compiled for
+SIGNATURE = "int64(float64[::1], int64[::1], int64[::1], float64[::1], float64[::1])"
+#: a size that does not fit the model
+WRONG_SIZE = -3
+
+
+def _jourdain_forward(fb, ib, t, q, u):
+    if q.shape[0] != t[7] or u.shape[0] != t[1]:
+        return WRONG_SIZE
+    return kp.jourdain_accelerations_packed(fb, ib, t, q, u)
+
+
+def _jourdain_state(fb, ib, t, y, ydot):
+    if y.shape[0] != t[7] + t[1] or ydot.shape[0] != y.shape[0]:
+        return WRONG_SIZE
+    return kp.state_derivative_packed(fb, ib, t, y, ydot)
+
+
+def _articulated_forward(fb, ib, t, q, u):
+    if q.shape[0] != t[7] or u.shape[0] != t[1]:
+        return WRONG_SIZE
+    return kp.articulated_accelerations_packed(fb, ib, t, q, u)
+
+
+def _articulated_state(fb, ib, t, y, ydot):
+    if y.shape[0] != t[7] + t[1] or ydot.shape[0] != y.shape[0]:
+        return WRONG_SIZE
+    return kp.state_derivative_articulated_packed(fb, ib, t, y, ydot)
+
+
+#: per-call formulations of the low-level entry: (forward dynamics, state derivative)
+ROUTES = {"jourdain": (_jourdain_forward, _jourdain_state),
+          "articulated": (_articulated_forward, _articulated_state)}
+_COMPILED = {}
+
+
+def _entry(function):
+    """``function`` compiled for ``SIGNATURE`` only, on first use (``import`` compiles
+    nothing); a call with any other argument types raises TypeError at once."""
+    if function not in _COMPILED:
+        _COMPILED[function] = njit(SIGNATURE, **UNCOUNTED)(function)
+    return _COMPILED[function]
 
 
 class LowLevel:
@@ -35,31 +77,34 @@ class LowLevel:
                              f"{', '.join(ROUTES)} (or 'auto')")
         self.model = model
         self.method = method
-        self._fd, self._sd = ROUTES[method]
+        self._fd, self._sd = (_entry(f) for f in ROUTES[method])
         self._fb, self._ib, self._t = model._packed
         self._ud = model._ud
         self._inputs = model._python_inputs
         self._nq, self._nu = model.nq, model.nu
         self._ydot = np.empty(model.nq + model.nu)
-        self._q_shape, self._u_shape = (model.nq,), (model.nu,)
-        self._y_shape = (model.nq + model.nu,)
         self.forward_dynamics = self._bind_forward_dynamics()
 
     def _bind_forward_dynamics(self):
         """``forward_dynamics`` as a closure over locals: attribute look-ups cost a tenth
-        of a small model's call."""
-        array, f64, fill, fail = _ARRAY, _F64, self.model._fill_inputs, self._fail
-        fd, fb, ib, table, ud = self._fd, self._fb, self._ib, self._t, self._ud
-        q_shape, u_shape, inputs, refuse = self._q_shape, self._u_shape, self._inputs, self._refuse
+        of a small model's call.  The types and sizes are checked by the compiled entry
+        (numba refuses any other type; the entry returns ``WRONG_SIZE``)."""
+        fill, fail, refuse = self.model._fill_inputs, self._fail, self._refuse
+        fd, fb, ib, table, ud, inputs = (self._fd, self._fb, self._ib, self._t, self._ud,
+                                         self._inputs)
 
         def forward_dynamics(q, u, t=0.0, out=None):
             """Speed rates ``u'`` (a workspace view unless ``out`` is given)."""
-            if not (q.__class__ is array and u.__class__ is array and q.dtype is f64
-                    and u.dtype is f64 and q.shape == q_shape and u.shape == u_shape):
-                refuse(q=q, u=u)
             if inputs:
+                refuse(q=q, u=u)          # (only when the inputs are good: nothing raised)
                 fill(q, u, t)
-            if fd(fb, ib, table, q, u) != -1:
+            try:
+                status = fd(fb, ib, table, q, u)
+            except TypeError:
+                status = WRONG_SIZE
+            if status != -1:
+                if status == WRONG_SIZE:
+                    refuse(q=q, u=u)
                 fail(q, u, t)
             if out is None:
                 return ud
@@ -72,27 +117,37 @@ class LowLevel:
 
     def state_derivative(self, y, t=0.0, out=None):
         """``[q', u']`` of ``y = [q, u]`` (a workspace array unless ``out`` is given)."""
-        if not (type(y) is _ARRAY and y.dtype is _F64 and y.shape == self._y_shape):
-            self._refuse(y=y)
         if self._inputs:
+            self._refuse(y=y)
             self.model._fill_inputs(y[:self._nq], y[self._nq:], t)
         ydot = self._ydot if out is None else out
-        status = self._sd(self._fb, self._ib, self._t, y, ydot)
+        try:
+            status = self._sd(self._fb, self._ib, self._t, y, ydot)
+        except TypeError:
+            status = WRONG_SIZE
         if status != -1:
+            if status == WRONG_SIZE:
+                self._refuse(y=y, out=ydot)
             self.model.state_derivative(t, y, self.method)   # raises the precise error
         return ydot
 
     def _refuse(self, **arrays):
-        sizes = {"q": self._nq, "u": self._nu, "y": self._nq + self._nu}
+        """Raise, naming the first of ``arrays`` that is not a C-contiguous float64 array of
+        the model's size; return if they all are."""
+        sizes = {"q": self._nq, "u": self._nu, "y": self._nq + self._nu,
+                 "out": self._nq + self._nu}
         for name, a in arrays.items():
             if not (isinstance(a, np.ndarray) and a.dtype == np.float64
-                    and a.shape == (sizes[name],)):
-                got = (f"{a.dtype} array of shape {a.shape}" if isinstance(a, np.ndarray)
-                       else type(a).__name__)
-                raise ModelError(f"lowlevel: {name} must be a float64 numpy array of shape "
-                                 f"({sizes[name]},), got {got}; convert it once with "
-                                 "np.asarray(..., dtype=float) outside the loop")
-        raise ModelError("lowlevel: the inputs must be plain float64 numpy arrays")
+                    and a.shape == (sizes[name],) and a.flags.c_contiguous
+                    and a.flags.writeable):
+                got = type(a).__name__
+                if isinstance(a, np.ndarray):
+                    kind = ("" if a.flags.c_contiguous else "non-contiguous ") + (
+                        "" if a.flags.writeable else "read-only ")
+                    got = f"{kind}{a.dtype} array of shape {a.shape}"
+                raise ModelError(f"lowlevel: {name} must be a contiguous, writable float64 "
+                                 f"numpy array of shape ({sizes[name]},), got {got}; convert "
+                                 "it once with np.array(..., dtype=float) outside the loop")
 
     def _fail(self, q, u, t):
         """Raise what went wrong, found by the checked call."""

@@ -159,11 +159,17 @@ def test_lowlevel_entry_gives_the_checked_answers_and_refuses_bad_arrays():
                               m.state_derivative(t.t, y, method))
     assert m.lowlevel().method == m.formulation()
     fast = m.lowlevel()
+    frozen = t.q.copy()
+    frozen.flags.writeable = False
     for bad, what in ((list(t.q), "list"), (t.q.astype(np.float32), "float32"),
-                      (np.zeros(m.nq + 1), r"shape \(%d,\)" % (m.nq + 1))):
-        with pytest.raises(mb.ModelError, match=f"q must be a float64.*{what}"):
+                      (np.zeros(m.nq + 1), r"shape \(%d,\)" % (m.nq + 1)),
+                      (np.zeros(2 * m.nq)[::2], "non-contiguous"), (frozen, "read-only")):
+        with pytest.raises(mb.ModelError, match=f"q must be a contiguous, writable float64.*{what}"):
             fast.forward_dynamics(bad, t.u, t.t)
-    with pytest.raises(mb.ModelError, match="y must be a float64"):
+    with pytest.raises(mb.ModelError, match="y must be a contiguous, writable float64"):
         fast.state_derivative(t.q)
+    with pytest.raises(mb.ModelError, match="out must be"):
+        fast.state_derivative(y, t.t, out=np.empty(len(y) - 1))
+    assert len(fast._fd.signatures) == len(fast._sd.signatures) == 1   # nothing compiled anew
     with pytest.raises(mb.ModelError, match="unknown method"):
         m.lowlevel("newton-euler-dense")

@@ -76,7 +76,7 @@ def pack(floats, ints):
     return fbuf, ibuf, table, views
 
 
-@njit(**UNCOUNTED)
+@njit(inline="always", **UNCOUNTED)
 def _views(fb, ib, t):
     """Every packed array as a view, in the order of the unpacked kernels' arguments:
     tree (11), body (mass, com, inertia, has_inertia, gravity), joint-space state (3),
@@ -136,7 +136,7 @@ def _views(fb, ib, t):
             scratch)
 
 
-@njit(**UNCOUNTED)
+@njit(inline="always", **UNCOUNTED)
 def _scatter(fb, ib, t, q, u):
     """Free coordinates and speeds into the joint-space state; their rates ``u'`` to zero
     (the Jourdain terms are evaluated at ``u' = 0``; driven entries are the caller's)."""
