@@ -1141,43 +1141,15 @@ def _run_fixed(rhs, integrator, t0, t_end, y0, dt, events, t_eval, progress, mon
     stop = False
     for times, states, chunk_failure in _fixed_chunks(rhs, integrator, t0, t_end, y0, dt,
                                                       compiled, events):
-        if not events:                      # no per-step work: take the stretch whole
-            n_ok, failure = monitor.check_rows(times, states)
-            kept.add(times[:n_ok], states[:n_ok])
-            steps += n_ok
-            if n_ok:
-                t, y = times[n_ok - 1], states[n_ok - 1]
-            times = times[:0]
-        for t_new, y_new in zip(times, states):
-            failure = monitor.check(t_new, y_new)
-            if failure:
-                break
-            steps += 1
-            if events:
-                try:
-                    g_new = _event_values(events, model, t_new, y_new)
-                except NonFiniteError as exc:
-                    failure = _describe_failure(model, exc, t_new, y_new)
-                    break
-                hits = []
-                for j, e in enumerate(events):
-                    if _crossed(e, g_old[j], g_new[j]):
-                        # linear interpolation between the two steps bracketing the crossing
-                        te = t + (t_new - t) * g_old[j] / (g_old[j] - g_new[j])
-                        hits.append((te, e))
-                for te, e in sorted(hits, key=lambda x: x[0]):
-                    w = (te - t) / (t_new - t) if t_new != t else 1.0
-                    ye = (1 - w) * y + w * y_new
-                    found.append(EventRecord(e.name, te, ye[:model.nq], ye[model.nq:],
-                                             model.coordinates + model.speeds))
-                    if e.terminal:
-                        stop = True
-                        break
-                g_old = g_new
-            t, y = t_new, y_new
-            kept.add(np.array([t]), y[None, :])
-            if stop:
-                break
+        if events:
+            processed, failure, stop, g_old = _fixed_stretch_events(
+                events, model, monitor, t, y, g_old, times, states, found)
+        else:
+            processed, failure = monitor.check_rows(times, states)
+        kept.add(times[:processed], states[:processed])
+        steps += processed
+        if processed:
+            t, y = times[processed - 1], states[processed - 1]
         if progress is not None:
             progress(t)
         failure = failure or (None if stop else chunk_failure)  # past a terminal event: moot
@@ -1196,6 +1168,59 @@ def _run_fixed(rhs, integrator, t0, t_end, y0, dt, events, t_eval, progress, mon
     if failure is not None:
         info["failure"] = failure
     return ts, ys, found, info
+
+
+def _fixed_stretch_events(events, model, monitor, t, y, g_old, times, states, found):
+    """The events of a stretch of fixed steps ``(times, states)`` after ``(t, y)`` (event
+    conditions ``g_old`` there), vectorized over the rows but with the outcome of a
+    step-by-step pass: each row is checked by ``monitor`` first, then its conditions; a
+    crossing is located by linear interpolation between the two rows bracketing it and
+    appended to ``found``; a terminal one ends the stretch after its row.  Returns
+    ``(rows processed, failure or None, stopped at a terminal event, conditions at the
+    last processed row)``."""
+    m = len(times)
+    G = _event_rows(events, model, times, states)
+    finite = np.all(np.isfinite(G), axis=1)
+    b = int(np.argmin(finite)) if not finite.all() else m      # first non-finite row
+    before = np.vstack([g_old[None, :], G[:-1]])
+    crossing = np.zeros((m, len(events)), bool)
+    for j, e in enumerate(events):
+        crossing[:b, j] = _crossed_rows(e, before[:b, j], G[:b, j])
+    terminal = np.array([e.terminal for e in events], bool)
+    rows_t = np.flatnonzero((crossing & terminal).any(axis=1))
+    r_t = int(rows_t[0]) if rows_t.size else None
+    limit = r_t + 1 if r_t is not None else min(b + 1, m)
+    n_ok, failure = monitor.check_rows(times[:limit], states[:limit])
+    if n_ok < limit:
+        processed = n_ok
+    elif r_t is not None:
+        processed = r_t + 1
+    elif b < m:
+        processed = b
+        try:
+            _event_values(events, model, times[b], states[b])    # raises its message
+        except NonFiniteError as exc:
+            failure = _describe_failure(model, exc, times[b], states[b])
+    else:
+        processed = m
+    stop = False
+    for r in np.flatnonzero(crossing[:processed].any(axis=1)):
+        t_old, y_old = (times[r - 1], states[r - 1]) if r else (t, y)
+        t_new, y_new = times[r], states[r]
+        hits = []
+        for j, e in enumerate(events):
+            if crossing[r, j]:
+                te = t_old + (t_new - t_old) * before[r, j] / (before[r, j] - G[r, j])
+                hits.append((te, e))
+        for te, e in sorted(hits, key=lambda x: x[0]):
+            w = (te - t_old) / (t_new - t_old) if t_new != t_old else 1.0
+            ye = (1 - w) * y_old + w * y_new
+            found.append(EventRecord(e.name, te, ye[:model.nq], ye[model.nq:],
+                                     model.coordinates + model.speeds))
+            if e.terminal:
+                stop = True
+                break
+    return processed, failure, stop, (G[processed - 1] if processed else g_old)
 
 
 def _fixed_step(rhs, integrator, t, y, h, nq):

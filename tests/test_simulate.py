@@ -160,6 +160,48 @@ def test_fixed_step_events_are_found_roughly(pendulum):
     assert res.t[-1] < QUARTER + 2e-3
 
 
+@pytest.mark.parametrize("integrator", ["rk4", "semi-implicit-euler"])
+def test_fixed_step_events_interpolate_between_the_steps_that_bracket_them(pendulum,
+                                                                          integrator):
+    """Events of a fixed-step run are found on whole stretches of steps at once; each must
+    be where a step-by-step pass puts it: the linear interpolation of its condition between
+    the two steps that bracket the crossing, in time order, the run ending at the row of
+    the first terminal one."""
+    either = mb.Event("either", lambda t, q, u: q[0])
+    slow = mb.Event("slow", lambda t, q, u: abs(u[0]) - 1.0)
+    target = -THETA0 / 2
+    half = mb.Event("half way up", lambda t, q, u: q[0] - target, direction=-1)
+    late = mb.Event("late", lambda t, q, u: t - 2.3451, terminal=True)
+    dt = 2e-3
+    res = mb.simulate(pendulum, 8.0, {"theta": THETA0}, integrator=integrator, dt=dt,
+                      events=[either, slow, half, late])
+    t, th, om = res.t, res["theta"], res["theta_dot"]
+    assert np.allclose(np.diff(t), dt)                    # every step is a sample
+    expected = []
+    for name, g in (("either", th), ("slow", np.abs(om) - 1.0), ("half way up", th - target),
+                    ("late", t - 2.3451)):
+        for k in np.flatnonzero((g[:-1] != 0) & (np.sign(g[:-1]) != np.sign(g[1:]))):
+            if name == "half way up" and g[k] < 0:
+                continue                                  # direction -1 only
+            expected.append((t[k] + (t[k + 1] - t[k]) * g[k] / (g[k] - g[k + 1]), name))
+    expected.sort()
+    assert [n for n, _ in res.events] == [n for _, n in expected]
+    assert np.allclose([te for _, te in res.events], [te for te, _ in expected],
+                       rtol=0, atol=1e-14)
+    assert res.events[-1][0] == "late" and t[-2] < res.events[-1][1] <= t[-1]
+    assert len(res.events) >= 8                           # several in one stretch
+
+
+def test_a_fixed_step_event_that_turns_non_finite_names_itself_and_keeps_the_steps(pendulum):
+    bad = mb.Event("log", lambda t, q, u: np.log(q[0] + 0.5))
+    with pytest.raises(mb.SimulationError, match="event 'log': the condition is not a finite") \
+            as info:
+        mb.simulate(pendulum, 3.0, {"theta": THETA0}, integrator="rk4", dt=1e-3, events=[bad])
+    kept = info.value.result
+    assert np.all(kept.q[:, 0] + 0.5 > 0)                 # every kept step was finite
+    assert kept.q[-1, 0] + 0.5 < 0.01                     # and the next one was not
+
+
 # ----------------------------------------------------------------------------- failures
 def test_nan_in_a_load_names_the_load_and_the_time():
     s = mb.System("pendulum with a bad load")

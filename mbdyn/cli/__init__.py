@@ -111,6 +111,10 @@ def _error(message):
 
 def main(argv=None):
     """Run the command line ``argv`` (default ``sys.argv[1:]``); returns the exit code."""
+    # The command's matrices are small: an OpenBLAS thread pool would only spin (a tenth
+    # of a second of CPU at start, and contention in sweeps).  Set before numpy loads; a
+    # value the user set is kept.
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = build_parser(_command(argv))
     try:
