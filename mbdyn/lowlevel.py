@@ -18,21 +18,34 @@ from numba import njit
 
 from .errors import ModelError
 from .kernels import packed as kp
-from .kernels.views import UNCOUNTED
+from .kernels.views import UNCOUNTED, c_view
 
 _ARRAY, _F64 = np.ndarray, np.dtype(np.float64)
 
 #: the one type the entry points accept: no other is compiled, so that a wrong array is
 #: refused by numba's dispatcher (a TypeError) instead of being compiled for
-SIGNATURE = "int64(float64[::1], int64[::1], int64[::1], float64[::1], float64[::1])"
+SIGNATURE = ("int64(float64[::1], int64[::1], int64[::1], float64[::1], float64[::1], "
+             "float64[::1])")
 #: a size that does not fit the model
 WRONG_SIZE = -3
 
 
-def _jourdain_forward(fb, ib, t, q, u):
-    if q.shape[0] != t[7] or u.shape[0] != t[1]:
+@njit(inline="always", **UNCOUNTED)
+def _forward(accelerations, fb, ib, t, q, u, out):
+    """``accelerations`` (a packed kernel) at ``q``, ``u``, its ``u'`` copied into ``out``
+    (which may be the workspace's own ``ud``) in compiled code."""
+    nu = t[1]
+    if q.shape[0] != t[7] or u.shape[0] != nu or out.shape[0] != nu:
         return WRONG_SIZE
-    return kp.jourdain_accelerations_packed(fb, ib, t, q, u)
+    status = accelerations(fb, ib, t, q, u)
+    ud = c_view(fb, t[kp.UD], (nu,))
+    for k in range(nu):
+        out[k] = ud[k]
+    return status
+
+
+def _jourdain_forward(fb, ib, t, q, u, out):
+    return _forward(kp.jourdain_accelerations_packed, fb, ib, t, q, u, out)
 
 
 def _jourdain_state(fb, ib, t, y, ydot):
@@ -41,10 +54,8 @@ def _jourdain_state(fb, ib, t, y, ydot):
     return kp.state_derivative_packed(fb, ib, t, y, ydot)
 
 
-def _articulated_forward(fb, ib, t, q, u):
-    if q.shape[0] != t[7] or u.shape[0] != t[1]:
-        return WRONG_SIZE
-    return kp.articulated_accelerations_packed(fb, ib, t, q, u)
+def _articulated_forward(fb, ib, t, q, u, out):
+    return _forward(kp.articulated_accelerations_packed, fb, ib, t, q, u, out)
 
 
 def _articulated_state(fb, ib, t, y, ydot):
@@ -56,14 +67,17 @@ def _articulated_state(fb, ib, t, y, ydot):
 #: per-call formulations of the low-level entry: (forward dynamics, state derivative)
 ROUTES = {"jourdain": (_jourdain_forward, _jourdain_state),
           "articulated": (_articulated_forward, _articulated_state)}
+#: the signatures of the two entry points
+SIGNATURES = (SIGNATURE, "int64(float64[::1], int64[::1], int64[::1], float64[::1], "
+                         "float64[::1])")
 _COMPILED = {}
 
 
-def _entry(function):
-    """``function`` compiled for ``SIGNATURE`` only, on first use (``import`` compiles
+def _entry(function, signature):
+    """``function`` compiled for ``signature`` only, on first use (``import`` compiles
     nothing); a call with any other argument types raises TypeError at once."""
     if function not in _COMPILED:
-        _COMPILED[function] = njit(SIGNATURE, **UNCOUNTED)(function)
+        _COMPILED[function] = njit(signature, **UNCOUNTED)(function)
     return _COMPILED[function]
 
 
@@ -77,7 +91,7 @@ class LowLevel:
                              f"{', '.join(ROUTES)} (or 'auto')")
         self.model = model
         self.method = method
-        self._fd, self._sd = (_entry(f) for f in ROUTES[method])
+        self._fd, self._sd = (_entry(f, sig) for f, sig in zip(ROUTES[method], SIGNATURES))
         self._fb, self._ib, self._t = model._packed
         self._ud = model._ud
         self._inputs = model._python_inputs
@@ -98,17 +112,16 @@ class LowLevel:
             if inputs:
                 refuse(q=q, u=u)          # (only when the inputs are good: nothing raised)
                 fill(q, u, t)
+            if out is None:
+                out = ud
             try:
-                status = fd(fb, ib, table, q, u)
+                status = fd(fb, ib, table, q, u, out)
             except TypeError:
                 status = WRONG_SIZE
             if status != -1:
                 if status == WRONG_SIZE:
-                    refuse(q=q, u=u)
+                    refuse(q=q, u=u, out=out)
                 fail(q, u, t)
-            if out is None:
-                return ud
-            out[:] = ud
             return out
         return forward_dynamics
 
@@ -135,7 +148,7 @@ class LowLevel:
         """Raise, naming the first of ``arrays`` that is not a C-contiguous float64 array of
         the model's size; return if they all are."""
         sizes = {"q": self._nq, "u": self._nu, "y": self._nq + self._nu,
-                 "out": self._nq + self._nu}
+                 "out": self._nq + self._nu if "y" in arrays else self._nu}
         for name, a in arrays.items():
             if not (isinstance(a, np.ndarray) and a.dtype == np.float64
                     and a.shape == (sizes[name],) and a.flags.c_contiguous

@@ -170,6 +170,8 @@ def test_lowlevel_entry_gives_the_checked_answers_and_refuses_bad_arrays():
         fast.state_derivative(t.q)
     with pytest.raises(mb.ModelError, match="out must be"):
         fast.state_derivative(y, t.t, out=np.empty(len(y) - 1))
+    with pytest.raises(mb.ModelError, match=r"out must be.*shape \(%d,\)" % m.nu):
+        fast.forward_dynamics(t.q, t.u, t.t, out=np.empty(m.nu + 1))
     assert len(fast._fd.signatures) == len(fast._sd.signatures) == 1   # nothing compiled anew
     with pytest.raises(mb.ModelError, match="unknown method"):
         m.lowlevel("newton-euler-dense")

@@ -28,11 +28,11 @@ import math
 
 from numba import njit
 
-from .joints import NU
+from .joints import EULER, NU, REVOLUTE, SPHERICAL
 from .views import UNCOUNTED, c_view
 
 #: floats of scratch ``articulated_body`` needs (``joint_wrenches_tree`` needs 6)
-ARTICULATED_WORK = 51
+ARTICULATED_WORK = 87
 
 
 @njit(cache=True, inline="always")
@@ -111,7 +111,7 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
     of freedom without inertia).  ``work``: ``ARTICULATED_WORK`` floats of scratch.
     """
     n = mass.shape[0]
-    Iw, Y = c_view(work, 0, (3, 3)), c_view(work, 9, (6, 3))
+    Iw, Y, Vbig = c_view(work, 0, (3, 3)), c_view(work, 9, (6, 3)), c_view(work, 51, (6, 6))
     c, wc, t1, t2 = (c_view(work, 27, (3,)), c_view(work, 30, (3,)), c_view(work, 33, (3,)),
                      c_view(work, 36, (3,)))
     rho, v6, wv = c_view(work, 39, (3,)), c_view(work, 42, (6,)), c_view(work, 48, (3,))
@@ -170,21 +170,30 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
     largest = 0.0
     for i in range(n - 1, -1, -1):
         col0 = ucol[i]
-        k = NU[kind[i]] if col0 >= 0 else 0
+        kd = kind[i]
+        k = NU[kd] if col0 >= 0 else 0
         if k:
-            # U = IA S, D = S^T U, and D's Cholesky factor in Dl[i, :k, :k]
+            # U = IA S, D = S^T U, and D's Cholesky factor in Dl[i, :k, :k].  A joint that
+            # only turns about the frame's origin (revolute, Euler angles, spherical) has
+            # zero translation columns: their terms, which come last, are skipped.
+            turns = kd == REVOLUTE or kd == EULER or kd == SPHERICAL
             for j in range(k):
                 col = col0 + j
+                s0, s1, s2 = JR[i, 0, col], JR[i, 1, col], JR[i, 2, col]
                 for a_ in range(6):
-                    U[i, a_, j] = (IA[i, a_, 0] * JR[i, 0, col] + IA[i, a_, 1] * JR[i, 1, col]
-                                   + IA[i, a_, 2] * JR[i, 2, col] + IA[i, a_, 3] * JT[i, 0, col]
-                                   + IA[i, a_, 4] * JT[i, 1, col] + IA[i, a_, 5] * JT[i, 2, col])
+                    s = IA[i, a_, 0] * s0 + IA[i, a_, 1] * s1 + IA[i, a_, 2] * s2
+                    if not turns:
+                        s += (IA[i, a_, 3] * JT[i, 0, col] + IA[i, a_, 4] * JT[i, 1, col]
+                              + IA[i, a_, 5] * JT[i, 2, col])
+                    U[i, a_, j] = s
             for j in range(k):
                 for m in range(j + 1):
                     col = col0 + m
                     s = (JR[i, 0, col] * U[i, 0, j] + JR[i, 1, col] * U[i, 1, j]
-                         + JR[i, 2, col] * U[i, 2, j] + JT[i, 0, col] * U[i, 3, j]
-                         + JT[i, 1, col] * U[i, 4, j] + JT[i, 2, col] * U[i, 5, j])
+                         + JR[i, 2, col] * U[i, 2, j])
+                    if not turns:
+                        s += (JT[i, 0, col] * U[i, 3, j] + JT[i, 1, col] * U[i, 4, j]
+                              + JT[i, 2, col] * U[i, 5, j])
                     for l_ in range(m):
                         s -= Dl[i, j, l_] * Dl[i, m, l_]
                     if m == j:
@@ -204,15 +213,22 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
             _cholesky_solve_small(Dl, i, k, v6)
             for j in range(k):
                 Dl[i, j, 6] = v6[j]
-            # Ia = IA - U D^-1 U^T ; pa = pA + Ia c + U D^-1 (-S^T pA)
+            # Ia = IA - U D^-1 U^T = IA - V^T V with V = L^-1 U^T (one triangular solve
+            # per row of U, not two); pa = pA + Ia c + U D^-1 (-S^T pA)
+            V = Y                                            # (6 x 3 scratch: k <= 3 here)
+            if k > 3:
+                V = Vbig
             for a_ in range(6):
                 for j in range(k):
-                    v6[j] = U[i, a_, j]
-                _cholesky_solve_small(Dl, i, k, v6)          # D^-1 U^T[:, a]
+                    s = U[i, a_, j]
+                    for l_ in range(j):
+                        s -= Dl[i, j, l_] * V[a_, l_]
+                    V[a_, j] = s / Dl[i, j, j]
+            for a_ in range(6):
                 for b_ in range(a_, 6):
                     s = 0.0
                     for j in range(k):
-                        s += U[i, b_, j] * v6[j]
+                        s += V[a_, j] * V[b_, j]
                     IA[i, a_, b_] -= s
                     if b_ != a_:
                         IA[i, b_, a_] = IA[i, a_, b_]
