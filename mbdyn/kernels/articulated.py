@@ -119,14 +119,14 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
     for i in range(n):
         for a_ in range(3):
             c[a_] = R[i, a_, 0] * com[i, 0] + R[i, a_, 1] * com[i, 1] + R[i, a_, 2] * com[i, 2]
-        for a_ in range(3):              # Iw = R I R^T
+        for a_ in range(3):              # Iw = R I R^T: Y[:3] = R I first
             for b_ in range(3):
-                s = 0.0
-                for k in range(3):
-                    s += R[i, a_, k] * (inertia[i, k, 0] * R[i, b_, 0]
-                                        + inertia[i, k, 1] * R[i, b_, 1]
-                                        + inertia[i, k, 2] * R[i, b_, 2])
-                Iw[a_, b_] = s
+                Y[a_, b_] = (R[i, a_, 0] * inertia[i, 0, b_] + R[i, a_, 1] * inertia[i, 1, b_]
+                             + R[i, a_, 2] * inertia[i, 2, b_])
+        for a_ in range(3):
+            for b_ in range(a_, 3):
+                Iw[a_, b_] = Iw[b_, a_] = (Y[a_, 0] * R[i, b_, 0] + Y[a_, 1] * R[i, b_, 1]
+                                           + Y[a_, 2] * R[i, b_, 2])
         m_i = mass[i]
         _spatial_inertia(m_i, c, Iw, IA, i)
         wi = wv
