@@ -24,8 +24,7 @@ _ARRAY, _F64 = np.ndarray, np.dtype(np.float64)
 
 #: the one type the entry points accept: no other is compiled, so that a wrong array is
 #: refused by numba's dispatcher (a TypeError) instead of being compiled for
-SIGNATURE = ("int64(float64[::1], int64[::1], int64[::1], float64[::1], float64[::1], "
-             "float64[::1])")
+SIGNATURE = "int64(float64[::1], int64[::1], float64[::1], float64[::1], float64[::1])"
 #: a size that does not fit the model
 WRONG_SIZE = -3
 
@@ -44,32 +43,34 @@ def _forward(accelerations, fb, ib, t, q, u, out):
     return status
 
 
-def _jourdain_forward(fb, ib, t, q, u, out):
-    return _forward(kp.jourdain_accelerations_packed, fb, ib, t, q, u, out)
+# The integer buffer ``ib`` starts with the offset table (``packed.pack``) and stands for it:
+# one array less for numba to type and unbox at every call.
+
+def _jourdain_forward(fb, ib, q, u, out):
+    return _forward(kp.jourdain_accelerations_packed, fb, ib, ib, q, u, out)
 
 
-def _jourdain_state(fb, ib, t, y, ydot):
-    if y.shape[0] != t[7] + t[1] or ydot.shape[0] != y.shape[0]:
+def _jourdain_state(fb, ib, y, ydot):
+    if y.shape[0] != ib[7] + ib[1] or ydot.shape[0] != y.shape[0]:
         return WRONG_SIZE
-    return kp.state_derivative_packed(fb, ib, t, y, ydot)
+    return kp.state_derivative_packed(fb, ib, ib, y, ydot)
 
 
-def _articulated_forward(fb, ib, t, q, u, out):
-    return _forward(kp.articulated_accelerations_packed, fb, ib, t, q, u, out)
+def _articulated_forward(fb, ib, q, u, out):
+    return _forward(kp.articulated_accelerations_packed, fb, ib, ib, q, u, out)
 
 
-def _articulated_state(fb, ib, t, y, ydot):
-    if y.shape[0] != t[7] + t[1] or ydot.shape[0] != y.shape[0]:
+def _articulated_state(fb, ib, y, ydot):
+    if y.shape[0] != ib[7] + ib[1] or ydot.shape[0] != y.shape[0]:
         return WRONG_SIZE
-    return kp.state_derivative_articulated_packed(fb, ib, t, y, ydot)
+    return kp.state_derivative_articulated_packed(fb, ib, ib, y, ydot)
 
 
 #: per-call formulations of the low-level entry: (forward dynamics, state derivative)
 ROUTES = {"jourdain": (_jourdain_forward, _jourdain_state),
           "articulated": (_articulated_forward, _articulated_state)}
 #: the signatures of the two entry points
-SIGNATURES = (SIGNATURE, "int64(float64[::1], int64[::1], int64[::1], float64[::1], "
-                         "float64[::1])")
+SIGNATURES = (SIGNATURE, "int64(float64[::1], int64[::1], float64[::1], float64[::1])")
 _COMPILED = {}
 
 
@@ -92,7 +93,7 @@ class LowLevel:
         self.model = model
         self.method = method
         self._fd, self._sd = (_entry(f, sig) for f, sig in zip(ROUTES[method], SIGNATURES))
-        self._fb, self._ib, self._t = model._packed
+        self._fb, self._ib, _ = model._packed
         self._ud = model._ud
         self._inputs = model._python_inputs
         self._nq, self._nu = model.nq, model.nu
@@ -104,8 +105,7 @@ class LowLevel:
         of a small model's call.  The types and sizes are checked by the compiled entry
         (numba refuses any other type; the entry returns ``WRONG_SIZE``)."""
         fill, fail, refuse = self.model._fill_inputs, self._fail, self._refuse
-        fd, fb, ib, table, ud, inputs = (self._fd, self._fb, self._ib, self._t, self._ud,
-                                         self._inputs)
+        fd, fb, ib, ud, inputs = self._fd, self._fb, self._ib, self._ud, self._inputs
 
         def forward_dynamics(q, u, t=0.0, out=None):
             """Speed rates ``u'`` (a workspace view unless ``out`` is given)."""
@@ -115,7 +115,7 @@ class LowLevel:
             if out is None:
                 out = ud
             try:
-                status = fd(fb, ib, table, q, u, out)
+                status = fd(fb, ib, q, u, out)
             except TypeError:
                 status = WRONG_SIZE
             if status != -1:
@@ -135,7 +135,7 @@ class LowLevel:
             self.model._fill_inputs(y[:self._nq], y[self._nq:], t)
         ydot = self._ydot if out is None else out
         try:
-            status = self._sd(self._fb, self._ib, self._t, y, ydot)
+            status = self._sd(self._fb, self._ib, y, ydot)
         except TypeError:
             status = WRONG_SIZE
         if status != -1:

@@ -47,7 +47,9 @@ SIZES = ("n", "nu", "nl", "nqf", "nuf", "nanc", "nreact", "nq", "nslots", "ne", 
 def pack(floats, ints):
     """Copy the arrays of ``floats`` and ``ints`` (dicts by the names in ``FLOATS``,
     ``INTS``) into two buffers.  Returns ``(fbuf, ibuf, table, views)``: ``table`` holds the
-    sizes (``SIZES``) and then each array's offset; ``views[name]`` is the array's view."""
+    sizes (``SIZES``) and then each array's offset; ``views[name]`` is the array's view.
+    The table is also the head of ``ibuf`` (``table`` is that view): ``ibuf`` can stand for
+    the table, so that an entry point takes one array less (``mbdyn.lowlevel``)."""
     sizes = {"n": floats["mass"].shape[0], "nu": floats["M"].shape[0],
              "nl": floats["load_force"].shape[0], "nqf": floats["qfull"].shape[0],
              "nuf": floats["ufull"].shape[0], "nanc": ints["anc_idx"].shape[0],
@@ -59,9 +61,10 @@ def pack(floats, ints):
     views = {}
     for names, source, dtype in ((FLOATS, floats, np.float64), (INTS, ints, np.int64)):
         first = len(SIZES) + (0 if names is FLOATS else len(FLOATS))
-        total = sum(np.asarray(source[k]).size for k in names)
+        head = 0 if names is FLOATS else table.shape[0]
+        total = head + sum(np.asarray(source[k]).size for k in names)
         buf = np.zeros(total, dtype)
-        at = 0
+        at = head
         for k, name in enumerate(names):
             arr = np.asarray(source[name])
             table[first + k] = at
@@ -73,7 +76,8 @@ def pack(floats, ints):
             fbuf = buf
         else:
             ibuf = buf
-    return fbuf, ibuf, table, views
+    ibuf[:table.shape[0]] = table
+    return fbuf, ibuf, ibuf[:table.shape[0]], views
 
 
 @njit(inline="always", **UNCOUNTED)
