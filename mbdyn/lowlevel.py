@@ -29,41 +29,45 @@ SIGNATURE = "int64(float64[::1], int64[::1], float64[::1], float64[::1], float64
 WRONG_SIZE = -3
 
 
+# The integer buffer ``ib`` starts with the offset table (``packed.pack``) and stands for it:
+# one array less for numba to type and unbox at every call.
+
 @njit(inline="always", **UNCOUNTED)
-def _forward(accelerations, fb, ib, t, q, u, out):
+def _forward(accelerations, fb, ib, q, u, out):
     """``accelerations`` (a packed kernel) at ``q``, ``u``, its ``u'`` copied into ``out``
     (which may be the workspace's own ``ud``) in compiled code."""
-    nu = t[1]
-    if q.shape[0] != t[7] or u.shape[0] != nu or out.shape[0] != nu:
+    nu = ib[1]
+    if q.shape[0] != ib[7] or u.shape[0] != nu or out.shape[0] != nu:
         return WRONG_SIZE
-    status = accelerations(fb, ib, t, q, u)
-    ud = c_view(fb, t[kp.UD], (nu,))
+    status = accelerations(fb, ib, ib, q, u)
+    ud = c_view(fb, ib[kp.UD], (nu,))
     for k in range(nu):
         out[k] = ud[k]
     return status
 
 
-# The integer buffer ``ib`` starts with the offset table (``packed.pack``) and stands for it:
-# one array less for numba to type and unbox at every call.
+@njit(inline="always", **UNCOUNTED)
+def _state(derivative, fb, ib, y, ydot):
+    """``derivative`` (a packed kernel) of ``y`` into ``ydot``, after the sizes."""
+    if y.shape[0] != ib[7] + ib[1] or ydot.shape[0] != y.shape[0]:
+        return WRONG_SIZE
+    return derivative(fb, ib, ib, y, ydot)
+
 
 def _jourdain_forward(fb, ib, q, u, out):
-    return _forward(kp.jourdain_accelerations_packed, fb, ib, ib, q, u, out)
+    return _forward(kp.jourdain_accelerations_packed, fb, ib, q, u, out)
 
 
 def _jourdain_state(fb, ib, y, ydot):
-    if y.shape[0] != ib[7] + ib[1] or ydot.shape[0] != y.shape[0]:
-        return WRONG_SIZE
-    return kp.state_derivative_packed(fb, ib, ib, y, ydot)
+    return _state(kp.state_derivative_packed, fb, ib, y, ydot)
 
 
 def _articulated_forward(fb, ib, q, u, out):
-    return _forward(kp.articulated_accelerations_packed, fb, ib, ib, q, u, out)
+    return _forward(kp.articulated_accelerations_packed, fb, ib, q, u, out)
 
 
 def _articulated_state(fb, ib, y, ydot):
-    if y.shape[0] != ib[7] + ib[1] or ydot.shape[0] != y.shape[0]:
-        return WRONG_SIZE
-    return kp.state_derivative_articulated_packed(fb, ib, ib, y, ydot)
+    return _state(kp.state_derivative_articulated_packed, fb, ib, y, ydot)
 
 
 #: per-call formulations of the low-level entry: (forward dynamics, state derivative)
