@@ -124,12 +124,14 @@ def test_external_dask_cluster_gives_the_same_table(serial_table, dask_cluster):
                               scheduler=dask_cluster))
 
 
-@pytest.mark.parametrize("integrator,t_end", [("rk4", 0.3), ("semi-implicit-euler", 0.30005)])
-def test_batched_members_bit_identical_to_single_runs(integrator, t_end):
+@pytest.mark.parametrize("integrator,t_end,method", [("rk4", 0.3, "auto"),
+                                                     ("semi-implicit-euler", 0.30005, "auto"),
+                                                     ("rk4", 0.3, "articulated")])
+def test_batched_members_bit_identical_to_single_runs(integrator, t_end, method):
     # 0.30005 s is not a whole number of steps: the shortened last step is batched too
     grid = {"initial.theta1": [0.1, 1.0, 3.0], "initial.theta2": [-0.5, "pi/4"]}
     fixed = {"simulation.integrator": integrator, "simulation.t_end": t_end,
-             "simulation.dt": 1e-3, "parameters.m1": 0.001}
+             "simulation.dt": 1e-3, "parameters.m1": 0.001, "simulation.method": method}
     q = ("final", "t_final", "steps", "rhs_evaluations")
     batched = sweep(PENDULUM, grid, q, fixed=fixed, batched=True)
     serial = sweep(PENDULUM, grid, q, fixed=fixed)

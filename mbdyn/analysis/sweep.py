@@ -298,9 +298,10 @@ def batchable(scene, quantities):
     model = scene.model
     if s["integrator"] not in FIXED_STEP:
         return f"integrator {s['integrator']!r} is adaptive; batched runs are fixed-step"
-    if s["method"] == "symbolic" or model.formulation(s["method"]) != "jourdain":
-        return ("batched runs use M u' = f (method 'jourdain'); this run's method is "
-                f"{s['method']!r}")
+    if s["method"] == "symbolic" or model.formulation(s["method"]) not in ("jourdain",
+                                                                           "articulated"):
+        return ("batched runs use M u' = f or the articulated-body algorithm (methods "
+                f"'jourdain', 'articulated', 'auto'); this run's method is {s['method']!r}")
     if scene.events:
         return "the model has events (checked per step in Python)"
     if model._euler_middle:
@@ -341,7 +342,8 @@ def run_batched(scenes, quantities):
     status = np.zeros(m, np.int64)
     nfev = np.zeros(m, np.int64)
     batched_fixed_step(SCHEMES[s["integrator"]], dt, n_full, h_last, Y0, table, last,
-                       *model.loop_arguments(), Yend, done, status, nfev)
+                       *model.loop_arguments(model.formulation(s["method"])), Yend, done,
+                       status, nfev)
     all_times = np.append(times, t_end) if h_last else times
     rows = []
     for i, sc in enumerate(scenes):

@@ -1,25 +1,41 @@
 """Batched ensembles: many members of one compiled model advanced in one compiled call.
 
 Each member differs only in its initial state ``Y0[i] = [q, u]``; the model's arrays are
-shared read-only, and each member gets its own copy of the workspace.  Members run in
+shared read-only, and each member gets its own copy of the workspace (laid out for
+``M u' = f`` or for the articulated-body algorithm, as the model's route is).  Members run in
 parallel over cores (numba ``prange``); each member runs the very same compiled fixed-step
 loop as a single run (``kernels.integrators.fixed_step_loop``), so a member's final state
 is bit-identical to ``simulate`` with the same scheme and step.
 """
 import numpy as np
 from numba import njit, prange
+from numba.extending import overload
 
 from .integrators import fixed_step_loop
 
 
-@njit(cache=True)
 def _own_workspace(ws):
-    """A private copy of the 17 workspace arrays of ``Model.loop_arguments`` (the
-    Jourdain layout; the last is the evaluations' scratch)."""
-    return (ws[0].copy(), ws[1].copy(), ws[2].copy(), ws[3].copy(), ws[4].copy(),
-            ws[5].copy(), ws[6].copy(), ws[7].copy(), ws[8].copy(), ws[9].copy(),
-            ws[10].copy(), ws[11].copy(), ws[12].copy(), ws[13].copy(), ws[14].copy(),
-            ws[15].copy(), ws[16].copy())
+    """A private copy of the workspace arrays of ``Model.loop_arguments`` (either layout:
+    17 arrays for ``M u' = f``, 20 for the articulated-body algorithm)."""
+    raise NotImplementedError("compiled code only")
+
+
+@overload(_own_workspace, inline="always")
+def _own_workspace_layout(ws):
+    if len(ws) == 17:
+        def jourdain_layout(ws):
+            return (ws[0].copy(), ws[1].copy(), ws[2].copy(), ws[3].copy(), ws[4].copy(),
+                    ws[5].copy(), ws[6].copy(), ws[7].copy(), ws[8].copy(), ws[9].copy(),
+                    ws[10].copy(), ws[11].copy(), ws[12].copy(), ws[13].copy(),
+                    ws[14].copy(), ws[15].copy(), ws[16].copy())
+        return jourdain_layout
+
+    def articulated_layout(ws):
+        return (ws[0].copy(), ws[1].copy(), ws[2].copy(), ws[3].copy(), ws[4].copy(),
+                ws[5].copy(), ws[6].copy(), ws[7].copy(), ws[8].copy(), ws[9].copy(),
+                ws[10].copy(), ws[11].copy(), ws[12].copy(), ws[13].copy(), ws[14].copy(),
+                ws[15].copy(), ws[16].copy(), ws[17].copy(), ws[18].copy(), ws[19].copy())
+    return articulated_layout
 
 
 @njit(cache=True, parallel=True)
