@@ -136,12 +136,14 @@ def euler_rate_matrix(seq, angles, rates, Hw, hw, Sm, Sv):
 @njit(**UNCOUNTED)
 def joint_motion(kind, axis, seq, qj, uj, Rrel, d, Hw, Hv, hw, hv, Sm, Sv):
     """Relative motion of one joint; see the module docstring for the outputs.
-    ``Sm`` (4x3x3) and ``Sv`` (8x3) are scratch."""
+    ``Sm`` (4x3x3) and ``Sv`` (8x3) are scratch.  Only the joint's own ``NU[kind]``
+    columns of ``Hw``, ``Hv`` are written."""
+    nu = NU[kind]
     for k in range(3):
         d[k] = 0.0
         hw[k] = 0.0
         hv[k] = 0.0
-        for c in range(MAX_NU):
+        for c in range(nu):
             Hw[k, c] = 0.0
             Hv[k, c] = 0.0
     if kind == FIXED:
