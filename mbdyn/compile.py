@@ -645,7 +645,14 @@ class Model:
 
     def mass_matrix(self, q, t=0.0):
         """The Jourdain mass matrix ``M(q)`` (nu x nu, symmetric)."""
-        self._jourdain_terms(q, np.zeros(self.nu), t)
+        return self._mass_matrix(q, t, self._jourdain_packed)
+
+    def _mass_matrix(self, q, t, terms):
+        """``mass_matrix`` with the Jourdain terms computed by ``terms``: the packed,
+        one-call route (``_jourdain_packed``) or the kernels a run compiles anyway
+        (``_jourdain_terms``; for the checks of a run, whose first start must not compile
+        the packed entry point).  The same kernels either way: the same numbers."""
+        terms(q, np.zeros(self.nu), t)
         # the sum is finite exactly when every entry is (short of overflow, which the
         # exact test below then clears): a third of the cost of isfinite().all()
         if not math.isfinite(self._M.sum()) and not np.all(np.isfinite(self._M)):
@@ -657,8 +664,18 @@ class Model:
     def forcing(self, q, u, t=0.0):
         """The right-hand side ``f(q, u, t)`` of ``M u' = f``: applied, gyroscopic and
         velocity-product terms projected by the Jacobians."""
-        self._jourdain_terms(q, u, t)
+        self._jourdain_packed(q, u, t)
         return self._f.copy()
+
+    def _jourdain_packed(self, q, u, t):
+        """``M`` and ``f`` into the workspace by one compiled call on the packed buffers
+        (``kernels.packed.jourdain_accelerations_packed``, which solves for ``u'`` too: a
+        small part of its cost, and no extra compiled entry point)."""
+        q, u = self._state(q, u)
+        if self._python_inputs:
+            self._fill_inputs(q, u, t)
+        kp.jourdain_accelerations_packed(*self._packed, q, u)
+        return q, u
 
     def forward_dynamics(self, q, u, t=0.0, method="jourdain"):
         """Speed rates ``u'``: from ``M(q) u' = f(q, u, t)`` (``method="jourdain"``), by the
@@ -1065,7 +1082,7 @@ class Model:
         if self.nu == 0:
             return 1.0, []
         try:
-            M = self.mass_matrix(q, t)
+            M = self._mass_matrix(q, t, self._jourdain_terms)
         except NonFiniteError:
             return float("inf"), []
         ev, vec = np.linalg.eigh(M)

@@ -65,6 +65,30 @@ def test_routes_agree_with_the_gyroscopic_effect_off(seed):
         assert rel(m.forward_dynamics(t.q, t.u, t.t, method=route), ref) < 1e-9
 
 
+@pytest.mark.parametrize("seed", range(12))
+def test_mass_matrix_and_forcing_by_one_call_are_the_runs_numbers(seed):
+    """``mass_matrix``/``forcing`` take one packed call; the checks of a run take the
+    kernels one by one (no extra compiled entry point): bit for bit the same, with drives,
+    state-dependent loads and the gyroscopic effect on or off."""
+    t = cached_tree(seed)
+    models = [t.model]
+    if seed % 3 == 0:
+        system, loads = build_system(t.spec)
+        off = system.compile(effects={"gyroscopic": False})
+        for _, fv, mv in loads:
+            for fn in (fv, mv):
+                if isinstance(fn, StateLoad):
+                    fn.bind(off)
+        models.append(off)
+    for m in models:
+        M = m.mass_matrix(t.q, t.t)
+        assert np.array_equal(M, m._mass_matrix(t.q, t.t, m._jourdain_terms))
+        f = m.forcing(t.q, t.u, t.t)
+        m._jourdain_terms(t.q, t.u, t.t)
+        assert np.array_equal(f, m._f)
+        assert np.allclose(M, M.T, rtol=0, atol=1e-12 * np.abs(M).max())
+
+
 @pytest.mark.skipif(np.finfo(np.longdouble).eps > 1e-18,
                     reason="needs an extended-precision longdouble for the reference")
 def test_ill_conditioned_ball_chain_keeps_its_digits():
