@@ -31,7 +31,8 @@ from numba import njit
 from .joints import EULER, NU, REVOLUTE, SPHERICAL
 from .views import UNCOUNTED, c_view
 
-#: floats of scratch ``articulated_body`` needs (``joint_wrenches_tree`` needs 6)
+#: floats of scratch ``articulated_body`` needs: ``ARTICULATED_WORK + 6 n`` for n frames
+#: (``joint_wrenches_tree`` needs 6)
 ARTICULATED_WORK = 87
 
 
@@ -108,10 +109,12 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
     ``W_i = Ia_i X_i A_p + pa_i`` (``joint_reactions``).
 
     Returns -1, or the first speed column where ``D`` is not positive definite (a degree
-    of freedom without inertia).  ``work``: ``ARTICULATED_WORK`` floats of scratch.
+    of freedom without inertia).  ``work``: ``ARTICULATED_WORK + 6 n`` floats of scratch
+    (the last ``6 n``: each joint's ``1 / L_jj``, so that its solves multiply).
     """
     n = mass.shape[0]
     Iw, Y, Vbig = c_view(work, 0, (3, 3)), c_view(work, 9, (6, 3)), c_view(work, 51, (6, 6))
+    inv = c_view(work, ARTICULATED_WORK, (n, 6))
     c, wc, t1, t2 = (c_view(work, 27, (3,)), c_view(work, 30, (3,)), c_view(work, 33, (3,)),
                      c_view(work, 36, (3,)))
     rho, v6, wv = c_view(work, 39, (3,)), c_view(work, 42, (6,)), c_view(work, 48, (3,))
@@ -201,8 +204,9 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
                             return col0 + j
                         largest = max(largest, s)
                         Dl[i, j, j] = math.sqrt(s)
+                        inv[i, j] = 1.0 / Dl[i, j, j]
                     else:
-                        Dl[i, j, m] = s / Dl[i, m, m]
+                        Dl[i, j, m] = s * inv[i, m]
             # the joint's own equations: S^T (IA A + pA) = 0  ->  u' = D^-1 (uv - U^T X A_p)
             # keep z = D^-1 (-S^T pA) in Dl[i, :k, 6]
             for j in range(k):
@@ -210,7 +214,7 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
                 v6[j] = -(JR[i, 0, col] * pA[i, 0] + JR[i, 1, col] * pA[i, 1]
                           + JR[i, 2, col] * pA[i, 2] + JT[i, 0, col] * pA[i, 3]
                           + JT[i, 1, col] * pA[i, 4] + JT[i, 2, col] * pA[i, 5])
-            _cholesky_solve_small(Dl, i, k, v6)
+            _cholesky_solve_small(Dl, inv, i, k, v6)
             for j in range(k):
                 Dl[i, j, 6] = v6[j]
             # Ia = IA - U D^-1 U^T = IA - V^T V with V = L^-1 U^T (one triangular solve
@@ -223,7 +227,7 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
                     s = U[i, a_, j]
                     for l_ in range(j):
                         s -= Dl[i, j, l_] * V[a_, l_]
-                    V[a_, j] = s / Dl[i, j, j]
+                    V[a_, j] = s * inv[i, j]
             for a_ in range(6):
                 for b_ in range(a_, 6):
                     s = 0.0
@@ -285,7 +289,7 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
                 for a_ in range(6):
                     s += U[i, a_, j] * acc[i, a_]
                 v6[j] = s
-            _cholesky_solve_small(Dl, i, k, v6)
+            _cholesky_solve_small(Dl, inv, i, k, v6)
             for j in range(k):
                 col = col0 + j
                 udj = Dl[i, j, 6] - v6[j]
@@ -297,18 +301,19 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
 
 
 @njit(cache=True, inline="always")
-def _cholesky_solve_small(Dl, f, k, x):
-    """``x <- D^-1 x`` for ``D = L L^T``, ``L`` lower triangular in ``Dl[f, :k, :k]``."""
+def _cholesky_solve_small(Dl, inv, f, k, x):
+    """``x <- D^-1 x`` for ``D = L L^T``, ``L`` lower triangular in ``Dl[f, :k, :k]``,
+    ``inv[f, :k]`` the inverses of its diagonal."""
     for i in range(k):
         s = x[i]
         for j in range(i):
             s -= Dl[f, i, j] * x[j]
-        x[i] = s / Dl[f, i, i]
+        x[i] = s * inv[f, i]
     for i in range(k - 1, -1, -1):
         s = x[i]
         for j in range(i + 1, k):
             s -= Dl[f, j, i] * x[j]
-        x[i] = s / Dl[f, i, i]
+        x[i] = s * inv[f, i]
 
 
 @njit(**UNCOUNTED)

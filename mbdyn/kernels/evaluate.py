@@ -23,7 +23,8 @@ def scratch_size(n, nu, nuf):
     joint-space speeds needs.  The steps use it one after another from its start, except
     the speeds ``drop_velocity_products`` keeps across a second kinematic pass (after the
     kinematics' part)."""
-    return max(KINEMATICS_WORK + nuf, FORCE_WORK, jourdain_work(n, nu), ARTICULATED_WORK)
+    return max(KINEMATICS_WORK + nuf, FORCE_WORK, jourdain_work(n, nu),
+               ARTICULATED_WORK + 6 * n)
 
 
 @njit(**UNCOUNTED)

@@ -16,7 +16,7 @@ speeds they are the velocity-product ("bias") accelerations, so that
 import numpy as np
 from numba import njit
 
-from .joints import MAX_NU, joint_motion
+from .joints import EULER, MAX_NU, REVOLUTE, SPHERICAL, joint_motion
 from .linalg3 import cross_to, mat_mat, mat_vec
 from .views import UNCOUNTED, c_view
 
@@ -111,22 +111,32 @@ def walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qf
         mat_vec(RJ0, d, t1)
         for k in range(3):
             rho[k] += t1[k]                   # parent origin -> child origin
-        # relative velocities and accelerations of the joint (child / J0 components)
+        # relative velocities and accelerations of the joint (child / J0 components); a
+        # joint that only turns about the child's origin has none of translation
+        turns = kd == REVOLUTE or kd == EULER or kd == SPHERICAL
         for k in range(3):
             wrel_b[k] = 0.0
             dwrel_b[k] = hw[k]
-            vrel_j[k] = 0.0
-            dvrel_j[k] = hv[k]
         for c in range(nu):
             for k in range(3):
                 wrel_b[k] += Hw[k, c] * uj[c]
                 dwrel_b[k] += Hw[k, c] * udj[c]
-                vrel_j[k] += Hv[k, c] * uj[c]
-                dvrel_j[k] += Hv[k, c] * udj[c]
         mat_vec(Ri, wrel_b, wrel)
-        mat_vec(RJ0, vrel_j, vrel)
         mat_vec(Ri, dwrel_b, t3)              # relative angular acceleration, world
-        mat_vec(RJ0, dvrel_j, t4)             # relative acceleration, world
+        if turns:
+            for k in range(3):
+                vrel[k] = 0.0
+                t4[k] = 0.0
+        else:
+            for k in range(3):
+                vrel_j[k] = 0.0
+                dvrel_j[k] = hv[k]
+            for c in range(nu):
+                for k in range(3):
+                    vrel_j[k] += Hv[k, c] * uj[c]
+                    dvrel_j[k] += Hv[k, c] * udj[c]
+            mat_vec(RJ0, vrel_j, vrel)
+            mat_vec(RJ0, dvrel_j, t4)         # relative acceleration, world
         if p >= 0:
             cross_to(wp, rho, t1)
             for k in range(3):
@@ -172,8 +182,8 @@ def walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qf
                 col = ucol[i] + c
                 for k in range(3):
                     JR[i, k, col] = Ri[k, 0] * Hw[0, c] + Ri[k, 1] * Hw[1, c] + Ri[k, 2] * Hw[2, c]
-                    JT[i, k, col] = (RJ0[k, 0] * Hv[0, c] + RJ0[k, 1] * Hv[1, c]
-                                     + RJ0[k, 2] * Hv[2, c])
+                    JT[i, k, col] = 0.0 if turns else (RJ0[k, 0] * Hv[0, c] + RJ0[k, 1] * Hv[1, c]
+                                                       + RJ0[k, 2] * Hv[2, c])
 
 
 @njit(**UNCOUNTED)
