@@ -61,17 +61,70 @@ class EventRecord(tuple):
 
 
 class CompiledCondition:
-    """``g(t, q, u)`` of a sympy condition over the model's names."""
+    """``g(t, q, u)`` of a sympy condition ``g`` over ``args`` (``t``, then the model's
+    coordinate and speed symbols): evaluated in compiled code by its program
+    (``mbdyn.programs.condition_program``), the same program the compiled loops run after
+    every step; by numpy when the stack machine cannot evaluate it (``program`` is
+    ``None``)."""
 
-    def __init__(self, fn, text):
-        self.fn = fn
-        self.text = text
+    def __init__(self, g, args, text):
+        from .programs import condition_program
+        self.g, self.args, self.text = g, tuple(args), text
+        self.program = condition_program(g, {s.name: k for k, s in enumerate(self.args[1:])})
+        self._fn = None
+        self._stack = None
+
+    @property
+    def fn(self):
+        """The numpy function ``fn(t, *q, *u)`` of the condition."""
+        if self._fn is None:
+            import sympy
+            self._fn = sympy.lambdify(self.args, self.g, modules="numpy")
+        return self._fn
 
     def __call__(self, t, q, u):
-        return float(self.fn(t, *q, *u))
+        if self.program is None:
+            return float(self.fn(t, *q, *u))
+        from .kernels.programs import STACK, evaluate
+        if self._stack is None:
+            self._stack = np.empty(STACK)
+        y = np.concatenate((np.asarray(q, dtype=float).ravel(),
+                            np.asarray(u, dtype=float).ravel()))
+        ops, consts = self.program
+        return float(evaluate(ops, consts, 0, len(ops), float(t), y, self._stack))
+
+    def rows(self, ts, ys):
+        """The condition at every row ``(ts[i], ys[i])`` of a motion (``ys`` rows
+        ``[q, u]``); ``None`` when it cannot be evaluated on whole columns."""
+        ts = np.ascontiguousarray(ts, dtype=float)
+        if self.program is not None:
+            from .kernels.events import condition_rows
+            from .kernels.programs import STACK
+            out = np.empty(ts.shape[0])
+            ops, consts = self.program
+            condition_rows(ops, consts, 0, len(ops), ts,
+                           np.ascontiguousarray(ys, dtype=float), np.empty(STACK), out)
+            return out
+        try:
+            v = np.asarray(self.fn(ts, *np.asarray(ys).T), dtype=float)
+        except (TypeError, ValueError):
+            return None
+        return np.broadcast_to(v, ts.shape).copy() if v.shape in ((), ts.shape) else None
+
+    def __getstate__(self):
+        return {**self.__dict__, "_fn": None, "_stack": None}
 
     def __repr__(self):
         return f"<condition {self.text!r}>"
+
+
+def sympy_condition(g, model, text):
+    """The ``CompiledCondition`` of ``g``, a sympy expression of ``t`` and the model's
+    coordinate and speed names (parameters already substituted)."""
+    import sympy
+    args = [sympy.Symbol(n) for n in ("t",) + model.coordinates + model.speeds]
+    g = g.subs({s: sympy.Symbol(s.name) for s in g.free_symbols})
+    return CompiledCondition(g, args, text)
 
 
 def compile_condition(condition, model, name):
@@ -109,10 +162,7 @@ def compile_condition(condition, model, name):
                          "a sympy expression, or a function g(t, q, u)")
     g = g.subs({s: model.parameters[s.name] for s in g.free_symbols
                 if s.name in model.parameters})
-    args = [sympy.Symbol(n) for n in ("t",) + model.coordinates + model.speeds]
-    g = g.subs({s: sympy.Symbol(s.name) for s in g.free_symbols})
-    fn = sympy.lambdify(args, g, modules="numpy")
-    return CompiledCondition(fn, text), implied
+    return sympy_condition(g, model, text), implied
 
 
 def as_event(e, model):

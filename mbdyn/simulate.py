@@ -742,15 +742,9 @@ def _event_rows(events, model, ts, ys):
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         for k, e in enumerate(events):
             g = e.condition
-            if isinstance(g, CompiledCondition):
-                try:
-                    v = np.asarray(g.fn(ts, *ys.T), dtype=float)
-                    if v.shape in ((), ts.shape):
-                        out[:, k] = v
-                        continue
-                except (TypeError, ValueError):
-                    pass                # not vectorizable: row by row below
-            out[:, k] = [float(g(t, y[:nq], y[nq:])) for t, y in zip(ts, ys)]
+            v = g.rows(ts, ys) if isinstance(g, CompiledCondition) else None
+            out[:, k] = v if v is not None else [float(g(t, y[:nq], y[nq:]))
+                                                 for t, y in zip(ts, ys)]
     return out
 
 
@@ -762,17 +756,20 @@ def _crossed_rows(e, g_old, g_new):
 
 
 def _stretch_events(events, model, g_old, t_start, y_start, T, Y, H, out_K, tab, dense_args,
-                    nfev):
+                    nfev, G=None):
     """The events of a stretch of accepted steps ``(T, Y, H)`` after ``(t_start, y_start)``
     (conditions ``g_old`` there; ``dense_args``: the drive programs and the model's arrays
     after ``dense_step``'s first ones): ``(G, ends, found)`` -- the conditions at every row, the
     rows where the stretch ends (``(row, 1, "event")`` at a non-finite condition,
     ``(row, 2, "terminal", t_event, state_at)``) and ``{row: [EventRecord, ...]}``, each
-    crossing located by brentq on the step's dense polynomial."""
+    crossing located by brentq on the step's dense polynomial.  ``G``: the conditions at the
+    rows when the stretch computed them (it then ended at its first crossing, and ``out_K``
+    holds that last step's stages in its last row)."""
     from .kernels.adaptive import dense_step, dense_values
     nq = model.nq
     ends, found = [], {}
-    G = _event_rows(events, model, T, Y)
+    if G is None:
+        G = _event_rows(events, model, T, Y)
     bad = np.flatnonzero(~np.all(np.isfinite(G), axis=1))
     if bad.size:
         ends.append((int(bad[0]), 1, "event"))
@@ -784,8 +781,8 @@ def _stretch_events(events, model, g_old, t_start, y_start, T, Y, H, out_K, tab,
     for r in np.flatnonzero(crossing.any(axis=1)):
         t_old = T[r - 1] if r else t_start
         y_old = Y[r - 1] if r else y_start
-        F, st = dense_step(tab.A, tab.C, tab.D, tab.stages, t_old, y_old, Y[r], H[r], out_K[r],
-                           *dense_args, nfev)
+        F, st = dense_step(tab.A, tab.C, tab.D, tab.stages, t_old, y_old, Y[r], H[r],
+                           out_K[min(r, len(out_K) - 1)], *dense_args, nfev)
         if st:          # not expected: the stages of an accepted step were finite
             raise NonFiniteError("the dense output of a step became non-finite")
 
@@ -843,7 +840,9 @@ def _run_adaptive_compiled(rhs, integrator, t0, t_end, y0, rtol, atol, max_step,
     output), the budgets, progress.  Output times are sampled inside the stretch; the
     drives are evaluated there by their ``programs`` (``mbdyn.programs``)."""
     from .kernels.adaptive import TABLEAUS, initial_step, rk_stretch
+    from .programs import EventPrograms
     model = rhs.model
+    conditions = EventPrograms.of(events)       # None: the conditions are checked in Python
     nq, n = model.nq, y0.size
     tab = TABLEAUS[integrator]
     kind, A, B, C, E, E3, D = tab.arrays()
@@ -887,20 +886,23 @@ def _run_adaptive_compiled(rhs, integrator, t0, t_end, y0, rtol, atol, max_step,
     fail = np.empty(n + 1)                          # a failing stage's time and state
     t, y = t0, y0.copy()
     stretch = STRETCH_FIRST
-    most = STRETCH_MOST_EVENTS if events else STRETCH_MOST
+    most = STRETCH_MOST_EVENTS if events and conditions is None else STRETCH_MOST
+    no_events = EventPrograms.none()
     failure = None
     while t < t_end and failure is None:
         m = int(min(stretch, budget["max_steps"] - steps))
         out_t, out_h = np.empty(m), np.empty(m)
         out_y = np.empty((m, n))
         out_nfev, out_ieval = np.empty(m, np.int64), np.empty(m, np.int64)
-        out_K = np.empty((m if events else 0, tab.stages, n))
+        out_K = np.empty((0 if not events else 1 if conditions else m, tab.stages, n))
+        checks = no_events if conditions is None else conditions.arguments(g_old, m, True)
         t_start, y_start, i_start = t, y.copy(), i_eval
         cpu = _time.process_time()
         acc, status, h_abs, i_eval = rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f,
                                                 h_abs, rtol, atol, max_step, m, grid, i_eval,
                                                 samples, *programs, *args, out_t, out_y,
-                                                out_h, out_nfev, out_ieval, out_K, fail, nfev)
+                                                out_h, out_nfev, out_ieval, out_K, fail, nfev,
+                                                checks)
         if _time.process_time() - cpu < STRETCH_CPU and stretch < most:
             stretch *= 2
         T, Y, H = out_t[:acc], out_y[:acc], out_h[:acc]
@@ -908,9 +910,9 @@ def _run_adaptive_compiled(rhs, integrator, t0, t_end, y0, rtol, atol, max_step,
         # singularity monitor, events, budgets
         ends, G, hits_by_row = [], None, {}
         if events and acc:
-            G, ends, hits_by_row = _stretch_events(events, model, g_old, t_start, y_start,
-                                                   T, Y, H, out_K, tab, programs + dense_args,
-                                                   nfev)
+            G, ends, hits_by_row = _stretch_events(
+                events, model, g_old, t_start, y_start, T, Y, H, out_K, tab,
+                programs + dense_args, nfev, None if conditions is None else checks[6][:acc])
         kept = (stored + 1 + np.arange(acc)) if t_eval is None else out_ieval[:acc]
         ends += _stretch_budget_ends(budget, steps, kept, T, H, t_end, recent)
         history = np.concatenate([recent, H])
@@ -995,11 +997,15 @@ def _run_adaptive_compiled(rhs, integrator, t0, t_end, y0, rtol, atol, max_step,
     return ts, ys, found, info
 
 
-def _fixed_chunks(rhs, integrator, t0, t_end, y0, dt, compiled, events=()):
-    """Yield ``(times, states, failure)`` stretches of the fixed-step motion after ``y0``.
+def _fixed_chunks(rhs, integrator, t0, t_end, y0, dt, compiled, events=(), g_old=None):
+    """Yield ``(times, states, failure, G)`` stretches of the fixed-step motion after ``y0``.
 
     Compiled path (``kernels.integrators``) when ``compiled``; else one Python step at a
-    time.  Steps are of size ``dt``, the last one shortened to end at ``t_end``.
+    time.  Steps are of size ``dt``, the last one shortened to end at ``t_end``.  ``G``: the
+    event conditions at the stretch's rows when the compiled loop evaluated them (their
+    programs, ``mbdyn.programs.EventPrograms``; ``g_old`` at ``y0``), else ``None``; such a
+    loop stops after a step where a terminal event occurred or a condition is not finite,
+    and so does the motion.
     """
     model = rhs.model
     n_full = int(np.floor((t_end - t0) / dt * (1 + 1e-12)))
@@ -1013,11 +1019,15 @@ def _fixed_chunks(rhs, integrator, t0, t_end, y0, dt, compiled, events=()):
     t = t0
     if compiled:
         from .kernels.integrators import LOOPS, SCHEMES, STAGES
+        from .programs import EventPrograms
         loop = LOOPS[SCHEMES[integrator]]
         args = model.loop_arguments(rhs.method)
-        # stretches between checks of events and singularities: short when there are
-        # some (a terminal event wastes at most a stretch), long otherwise
-        chunk = 200 if (events or model._euler_middle) else 2000
+        conditions = EventPrograms.of(events)
+        checks = EventPrograms.none()
+        # stretches between checks in Python: short when there are events the loop cannot
+        # check or Euler-angle singularities to watch (a terminal event or a singularity
+        # wastes at most a stretch), long otherwise
+        chunk = 200 if ((events and conditions is None) or model._euler_middle) else 2000
         for h, ts in plan:
             for lo in range(0, len(ts), chunk):
                 tk = ts[lo:lo + chunk]
@@ -1026,15 +1036,20 @@ def _fixed_chunks(rhs, integrator, t0, t_end, y0, dt, compiled, events=()):
                 table = model.drive_values(stage_times).reshape(len(tk), len(STAGES), -1, 3)
                 out = np.empty((len(tk) + 1, y.size))
                 nfev = np.zeros(1, np.int64)
-                done, status = loop(h, y, table, *args, out, nfev)
+                if conditions is not None:
+                    checks = conditions.arguments(g_old, len(tk), False)
+                done, status = loop(h, y, table, *args, out, nfev, tk, checks)
                 rhs.evaluations += int(nfev[0])
                 failure = None
                 if status:
                     t_fail = tk[done - 1] if done else t
                     failure = _describe_failure(model, _LOOP_STATUS[status](model), t_fail,
                                                 out[done])
-                yield tk[:done], out[1:done + 1], failure
-                if status:
+                G = None
+                if conditions is not None:
+                    G, g_old = checks[6][:done], checks[5]
+                yield tk[:done], out[1:done + 1], failure, G
+                if status or done < len(tk):
                     return
                 t, y = tk[-1], out[-1].copy()
         return
@@ -1043,7 +1058,8 @@ def _fixed_chunks(rhs, integrator, t0, t_end, y0, dt, compiled, events=()):
             try:
                 y_new = _fixed_step(rhs, integrator, t, y, h, model.nq)
             except (NonFiniteError, SingularMassMatrixError) as exc:
-                yield np.empty(0), np.empty((0, y.size)), _describe_failure(model, exc, t, y)
+                yield (np.empty(0), np.empty((0, y.size)), _describe_failure(model, exc, t, y),
+                       None)
                 return
             model.normalize_quaternions(y_new[:model.nq])
             if not np.all(np.isfinite(y_new)):
@@ -1051,9 +1067,9 @@ def _fixed_chunks(rhs, integrator, t0, t_end, y0, dt, compiled, events=()):
                        if not np.isfinite(v)]
                 yield np.empty(0), np.empty((0, y.size)), _describe_failure(
                     model, NonFiniteError(f"the state became non-finite in {', '.join(bad)}"),
-                    t, y)
+                    t, y), None
                 return
-            yield np.array([t_new]), y_new[None, :], None
+            yield np.array([t_new]), y_new[None, :], None, None
             t, y = t_new, y_new
 
 
@@ -1139,11 +1155,11 @@ def _run_fixed(rhs, integrator, t0, t_end, y0, dt, events, t_eval, progress, mon
     failure = None
     steps = 0
     stop = False
-    for times, states, chunk_failure in _fixed_chunks(rhs, integrator, t0, t_end, y0, dt,
-                                                      compiled, events):
+    for times, states, chunk_failure, G in _fixed_chunks(rhs, integrator, t0, t_end, y0, dt,
+                                                         compiled, events, g_old):
         if events:
             processed, failure, stop, g_old = _fixed_stretch_events(
-                events, model, monitor, t, y, g_old, times, states, found)
+                events, model, monitor, t, y, g_old, times, states, found, G)
         else:
             processed, failure = monitor.check_rows(times, states)
         kept.add(times[:processed], states[:processed])
@@ -1170,16 +1186,17 @@ def _run_fixed(rhs, integrator, t0, t_end, y0, dt, events, t_eval, progress, mon
     return ts, ys, found, info
 
 
-def _fixed_stretch_events(events, model, monitor, t, y, g_old, times, states, found):
+def _fixed_stretch_events(events, model, monitor, t, y, g_old, times, states, found, G=None):
     """The events of a stretch of fixed steps ``(times, states)`` after ``(t, y)`` (event
     conditions ``g_old`` there), vectorized over the rows but with the outcome of a
     step-by-step pass: each row is checked by ``monitor`` first, then its conditions; a
     crossing is located by linear interpolation between the two rows bracketing it and
     appended to ``found``; a terminal one ends the stretch after its row.  Returns
     ``(rows processed, failure or None, stopped at a terminal event, conditions at the
-    last processed row)``."""
+    last processed row)``.  ``G``: the conditions at the rows, if the loop computed them."""
     m = len(times)
-    G = _event_rows(events, model, times, states)
+    if G is None:
+        G = _event_rows(events, model, times, states)
     finite = np.all(np.isfinite(G), axis=1)
     b = int(np.argmin(finite)) if not finite.all() else m      # first non-finite row
     before = np.vstack([g_old[None, :], G[:-1]])

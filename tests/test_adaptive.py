@@ -11,6 +11,7 @@ import mbdyn as mb
 import importlib
 from mbdyn.io import load_model
 from mbdyn.kernels import adaptive as ka
+from mbdyn.programs import EventPrograms
 
 from closed_forms import quaternion_zxz
 from textbook_systems import DOUBLE_PENDULUM_DATA, TOP_DATA, double_pendulum_system, top_system
@@ -100,7 +101,7 @@ def test_a_non_finite_stage_stops_the_kernel_with_its_state(pendulum):
     no_drives = (np.empty((0, 2), np.int64), np.empty(0), np.zeros(1, np.int64))
     acc, status, _, _ = ka.rk_stretch(*tab.arrays(), 0.0, 1.0, y, f, 10.0, 1e-9, 1e-12,
                                       np.inf, m, np.empty(0), 0, np.empty((0, n)), *no_drives,
-                                      *args, *out)
+                                      *args, *out, EventPrograms.none())
     assert (acc, status) == (0, 1)
     with pytest.raises(mb.NonFiniteError, match="non-finite"):
         pendulum.state_derivative(out[6][0], out[6][1:])    # the stage it left

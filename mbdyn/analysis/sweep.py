@@ -303,7 +303,8 @@ def batchable(scene, quantities):
         return ("batched runs use M u' = f or the articulated-body algorithm (methods "
                 f"'jourdain', 'articulated', 'auto'); this run's method is {s['method']!r}")
     if scene.events:
-        return "the model has events (checked per step in Python)"
+        return ("the model has events (batched members keep only their final state, "
+                "not the events on the way)")
     if model._euler_middle:
         return "the model has Euler-angle joints (their singularity is checked per step)"
     if model.has_callable_loads:

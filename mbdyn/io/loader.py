@@ -30,7 +30,7 @@ from ..model import GROUND, System
 from ..simulate import DEFAULTS as SIMULATE_DEFAULTS
 from ..simulate import FIXED_STEP, INTEGRATORS, Event, Result
 from ..simulate import simulate as _simulate
-from ..events import CompiledCondition as _Condition
+from ..events import sympy_condition as _condition
 from .errors import ModelFileError
 from .expressions import ExpressionError, parse, parse_condition, symbol, to_float
 from .schema import (DIRECTIONS, Checker, _suggest, apply_case, apply_override,
@@ -770,8 +770,6 @@ class _SceneBuilder:
         model = self.model
         events, specs = [], []
         seen = set()
-        coords = [symbol(n) for n in model.coordinates]
-        speeds = [symbol(n) for n in model.speeds]
         for i, e in enumerate(self.doc.get("events", [])):
             path = ("events", i)
             name = self.required(e, "name", path, "event")
@@ -796,8 +794,7 @@ class _SceneBuilder:
             direction = explicit if explicit is not None else (implied or 0)
             g = g.subs({s: self.values[s.name] for s in g.free_symbols
                         if s.name in self.values})
-            fn = sympy.lambdify([TIME] + coords + speeds, g, modules="numpy")
-            cond = _Condition(fn, text)
+            cond = _condition(g, model, text)
             try:
                 g0 = cond(0.0, q0, u0)
             except (ArithmeticError, ValueError, TypeError) as exc:

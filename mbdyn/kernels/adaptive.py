@@ -25,6 +25,7 @@ size below the roundoff of ``t``.
 import numpy as np
 from numba import njit
 
+from .events import step_ends_stretch
 from .integrators import _rhs
 from .programs import STACK, drive_values
 from .views import untracked
@@ -264,13 +265,16 @@ def _dense_value(F, y_old, x, out):
 def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_step,
                max_accept, t_eval, i_eval, samples, ops, consts, starts, nq, slots, quats,
                free_q, free_u, drive_q, drive_u, tree, body, loads, ws, out_t, out_y, out_h,
-               out_nfev, out_ieval, out_K, fail, nfev):
+               out_nfev, out_ieval, out_K, fail, nfev, events):
     """Up to ``max_accept`` accepted steps from ``(t, y)`` (``f`` its derivative, ``h_abs``
     the proposed step) towards ``t_end``.  Accepted step ``k``: ``out_t[k]``,
     ``out_y[k]``, its size ``out_h[k]``, the evaluations so far ``out_nfev[k]``, the
-    samples so far ``out_ieval[k]``; its stages in ``out_K[k]`` when ``out_K`` has rows.
+    samples so far ``out_ieval[k]``; its stages in ``out_K[k]`` when ``out_K`` has rows
+    (the last row when it has fewer: ``out_K`` of one row keeps the last step's stages).
     Output times ``t_eval[i_eval:]`` passed are sampled on the dense output into
     ``samples``.  ``y``, ``f`` end as the last accepted state and its derivative.
+    ``events``: the event conditions (``kernels.events``), checked after every step; the
+    stretch ends early after a step where one crossed zero or is not finite.
     On failure ``fail`` holds the stage's time, then its state.  Returns
     ``(accepted, status, h_abs, i_eval)``; ``quats`` is unused (no projection: the drift is
     reported, as with scipy's solvers)."""
@@ -284,7 +288,8 @@ def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_s
     F = np.empty((3 + D.shape[0], n))
     stack = np.empty(STACK)
     dv = np.empty((drive_q.shape[0], 3))
-    keep_stages = out_K.shape[0] > 0
+    keep_stages = out_K.shape[0]
+    check_events = events[3].shape[0] > 0
     exponent = -1.0 / (5.0 if kind == RK45 else 8.0)
     accepted = 0
     while accepted < max_accept and t < t_end:
@@ -377,9 +382,10 @@ def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_s
                 _dense_value(F, y, (t_eval[i_eval] - t) / h, samples[i_eval])
                 i_eval += 1
         if keep_stages:
+            row = min(accepted, keep_stages - 1)
             for s in range(stages):
                 for i in range(n):
-                    out_K[accepted, s, i] = K[s, i]
+                    out_K[row, s, i] = K[s, i]
         for i in range(n):
             y[i] = y_new[i]
             f[i] = K[stages - 1, i]
@@ -390,6 +396,8 @@ def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_s
         out_nfev[accepted] = nfev[0]
         out_ieval[accepted] = i_eval
         accepted += 1
+        if check_events and step_ends_stretch(events, t, y, accepted - 1):
+            break
     return accepted, 0, h_abs, i_eval
 
 

@@ -19,6 +19,7 @@ from numba import njit
 from numba.extending import overload
 
 from .evaluate import articulated_accelerations, jourdain_accelerations
+from .events import step_ends_stretch
 from .joints import coordinate_rates
 from .views import untracked
 
@@ -192,33 +193,39 @@ def _scratch(ny):
 
 # One compiled loop per scheme, so that a run compiles only its own scheme's step (a loop
 # over all four would compile all of them: about 9 s of a first run).  The loops differ
-# only in the step they call.
+# only in the step they call.  After each step they check the run's event conditions
+# (``kernels.events``; ``times[n]``: the time after step ``n``) and return early, status 0,
+# after a step where a terminal one crossed zero or one is not finite.
 
 @njit(cache=True)
 def euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, drive_u,
-               tree, body, loads, ws, out, nfev):
+               tree, body, loads, ws, out, nfev, times, events):
     """``fixed_step_loop`` with explicit Euler."""
     _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
     tree, body, loads, ws = untracked(tree), untracked(body), untracked(loads), untracked(ws)
     out, drive_table = untracked(out), untracked(drive_table)
+    check_events = events[3].shape[0] > 0
     for n in range(out.shape[0] - 1):
         st = euler_step(h, out[n], out[n + 1], drive_table[n], nq, slots, free_q, free_u,
                         drive_q, drive_u, tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
         if st:
             return n, st
         _normalize(out[n + 1], quats)
+        if check_events and step_ends_stretch(events, times[n], out[n + 1], n):
+            return n + 1, 0
     return out.shape[0] - 1, 0
 
 
 @njit(cache=True)
 def semi_implicit_euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q,
-                             drive_u, tree, body, loads, ws, out, nfev):
+                             drive_u, tree, body, loads, ws, out, nfev, times, events):
     """``fixed_step_loop`` with semi-implicit Euler."""
     _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
     tree, body, loads, ws = untracked(tree), untracked(body), untracked(loads), untracked(ws)
     out, drive_table = untracked(out), untracked(drive_table)
+    check_events = events[3].shape[0] > 0
     for n in range(out.shape[0] - 1):
         st = semi_implicit_euler_step(h, out[n], out[n + 1], drive_table[n], nq, slots,
                                       free_q, free_u, drive_q, drive_u, tree, body, loads, ws,
@@ -226,34 +233,40 @@ def semi_implicit_euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_
         if st:
             return n, st
         _normalize(out[n + 1], quats)
+        if check_events and step_ends_stretch(events, times[n], out[n + 1], n):
+            return n + 1, 0
     return out.shape[0] - 1, 0
 
 
 @njit(cache=True)
 def rk4_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, drive_u, tree,
-             body, loads, ws, out, nfev):
+             body, loads, ws, out, nfev, times, events):
     """``fixed_step_loop`` with RK4."""
     _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
     tree, body, loads, ws = untracked(tree), untracked(body), untracked(loads), untracked(ws)
     out, drive_table = untracked(out), untracked(drive_table)
+    check_events = events[3].shape[0] > 0
     for n in range(out.shape[0] - 1):
         st = rk4_step(h, out[n], out[n + 1], drive_table[n], nq, slots, free_q, free_u,
                       drive_q, drive_u, tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
         if st:
             return n, st
         _normalize(out[n + 1], quats)
+        if check_events and step_ends_stretch(events, times[n], out[n + 1], n):
+            return n + 1, 0
     return out.shape[0] - 1, 0
 
 
 @njit(cache=True)
 def implicit_midpoint_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q,
-                           drive_u, tree, body, loads, ws, out, nfev):
+                           drive_u, tree, body, loads, ws, out, nfev, times, events):
     """``fixed_step_loop`` with the implicit midpoint rule."""
     _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
     tree, body, loads, ws = untracked(tree), untracked(body), untracked(loads), untracked(ws)
     out, drive_table = untracked(out), untracked(drive_table)
+    check_events = events[3].shape[0] > 0
     for n in range(out.shape[0] - 1):
         st = midpoint_step(h, out[n], out[n + 1], drive_table[n], nq, slots, free_q, free_u,
                            drive_q, drive_u, tree, body, loads, ws, k1, k2, k3, k4, tmp, J,
@@ -261,6 +274,8 @@ def implicit_midpoint_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u,
         if st:
             return n, st
         _normalize(out[n + 1], quats)
+        if check_events and step_ends_stretch(events, times[n], out[n + 1], n):
+            return n + 1, 0
     return out.shape[0] - 1, 0
 
 

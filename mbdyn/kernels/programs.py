@@ -1,25 +1,27 @@
-"""A small stack machine for expressions of time in compiled code (the drives' ``q(t)``,
-``q'(t)``, ``q''(t)``).
+"""A small stack machine for expressions in compiled code: the drives' ``q(t)``, ``q'(t)``,
+``q''(t)``, and the event conditions ``g(t, q, u)``.
 
 A program is a row range of ``ops`` (``(opcode, argument)`` pairs, postfix order) over the
 constants ``consts``; ``mbdyn.programs`` writes them from sympy expressions.  Opcodes:
-``CONST k`` pushes ``consts[k]``, ``TIME`` pushes ``t``, ``ADD n``/``MUL n`` replace the top
-``n`` values by their sum/product, ``POW`` replaces ``base, exponent`` by the power, the
-others apply a function of one value (``ATAN2`` of two) to the top.
+``CONST k`` pushes ``consts[k]``, ``TIME`` pushes ``t``, ``VAR k`` pushes the state's
+``y[k]`` (``y = [q, u]``), ``ADD n``/``MUL n``/``MIN n``/``MAX n`` replace the top ``n``
+values by their sum/product/least/greatest, ``POW`` replaces ``base, exponent`` by the
+power, ``ATAN2`` replaces ``y, x`` by ``atan2(y, x)``, the others apply a function of one
+value to the top.
 """
 import numpy as np
 from numba import njit
 
 (CONST, TIME, ADD, MUL, POW, SIN, COS, TAN, EXP, LOG, ASIN, ACOS, ATAN, SINH, COSH, TANH,
- ABS, ATAN2) = range(18)
+ ABS, ATAN2, VAR, SQRT, SIGN, MIN, MAX) = range(23)
 #: the deepest stack a program may need
 STACK = 64
 
 
 @njit(cache=True)
-def evaluate(ops, consts, first, last, t, stack):
-    """The value at ``t`` of the program ``ops[first:last]`` (``stack``: scratch space of
-    ``STACK`` values)."""
+def evaluate(ops, consts, first, last, t, y, stack):
+    """The value at ``(t, y)`` of the program ``ops[first:last]`` (``stack``: scratch space
+    of ``STACK`` values)."""
     top = 0
     for k in range(first, last):
         op = ops[k, 0]
@@ -29,6 +31,9 @@ def evaluate(ops, consts, first, last, t, stack):
             top += 1
         elif op == TIME:
             stack[top] = t
+            top += 1
+        elif op == VAR:
+            stack[top] = y[arg]
             top += 1
         elif op == ADD:
             acc = 0.0
@@ -41,6 +46,15 @@ def evaluate(ops, consts, first, last, t, stack):
             acc = 1.0
             for j in range(top - arg, top):
                 acc *= stack[j]
+            top -= arg
+            stack[top] = acc
+            top += 1
+        elif op == MIN or op == MAX:
+            acc = stack[top - arg]
+            for j in range(top - arg + 1, top):
+                v = stack[j]
+                if v != v or ((v < acc) if op == MIN else (v > acc)):     # NaN sticks
+                    acc = v
             top -= arg
             stack[top] = acc
             top += 1
@@ -74,6 +88,10 @@ def evaluate(ops, consts, first, last, t, stack):
                 x = np.cosh(x)
             elif op == TANH:
                 x = np.tanh(x)
+            elif op == SQRT:
+                x = np.sqrt(x) if x >= 0.0 else np.nan
+            elif op == SIGN:
+                x = np.sign(x)
             else:
                 x = abs(x)
             stack[top - 1] = x
@@ -83,8 +101,9 @@ def evaluate(ops, consts, first, last, t, stack):
 @njit(cache=True, inline="always")
 def drive_values(ops, consts, starts, t, stack, out):
     """``out[d] = (q, q', q'')`` of every drive ``d`` at ``t``: programs ``3 d .. 3 d + 2``
-    (``starts[k] .. starts[k + 1]`` their rows)."""
+    (``starts[k] .. starts[k + 1]`` their rows).  Drives are functions of ``t`` alone (no
+    ``VAR``), so the state argument is a stand-in."""
     for d in range(out.shape[0]):
         for p in range(3):
             k = 3 * d + p
-            out[d, p] = evaluate(ops, consts, starts[k], starts[k + 1], t, stack)
+            out[d, p] = evaluate(ops, consts, starts[k], starts[k + 1], t, stack, stack)
