@@ -62,17 +62,29 @@ def drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, an
         ufull[k] = saved[k]
 
 
-@njit(**UNCOUNTED)
-def jourdain_accelerations(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
-                           mass, com, inertia, has_inertia, gravity, qfull, ufull, udfull,
-                           load_body, load_point, load_force, load_moment, load_in_body,
-                           force_int, force_data, switches,
-                           R, r, w, v, alpha, a, JR, JT, F, N, M, f, L, ud, scratch):
-    """Kinematics, loads, ``M`` and ``f``, then ``ud = M^-1 f`` by Cholesky.
+# The two accelerations below take their arrays in groups (tuples, as ``packed._views``
+# returns them) and are inlined into their callers: a call of some forty arrays costs a
+# tenth of a small model's evaluation, and Python compiles a call of more than 30
+# arguments as a call with ``*args``, which numba cannot inline.
+
+@njit(inline="always", **UNCOUNTED)
+def jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch):
+    """Kinematics, loads, ``M`` and ``f``, then ``ud = M^-1 f`` by Cholesky.  The groups:
+    ``tree`` (``parent .. anc_idx``), ``body`` (``mass, com, inertia, has_inertia,
+    gravity``), ``state`` (``qfull, ufull, udfull``), ``loads`` (``load_body ..
+    switches``), ``motion`` (``R, r, w, v, alpha, a, JR, JT, F, N``), ``jourdain`` (``M, f,
+    L, ud``).
 
     Returns -1 on success, the index of the speed where the Cholesky factorisation broke
     down, or -2 when ``ud`` holds NaN or Inf.
     """
+    parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx = tree
+    mass, com, inertia, has_inertia, gravity = body
+    qfull, ufull, udfull = state
+    (load_body, load_point, load_force, load_moment, load_in_body, force_int, force_data,
+     switches) = loads
+    R, r, w, v, alpha, a, JR, JT, F, N = motion
+    M, f, L, ud = jourdain
     kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                          mass, com, gravity, qfull, ufull, udfull,
                          load_body, load_point, load_force, load_moment, load_in_body,
@@ -118,20 +130,24 @@ def newton_euler_solution(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc
     return np.linalg.solve(A, b)
 
 
-@njit(**UNCOUNTED)
-def articulated_accelerations(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr,
-                              own_idx, mass, com, inertia, gravity, qfull, ufull, udfull,
-                              load_body, load_point, load_force, load_moment, load_in_body,
-                              force_int, force_data, switches,
-                              R, r, w, v, alpha, a, JR, JT, F, N, IA, pA, cb, U, Dl, acc, ud,
-                              scratch):
-    """Kinematics, loads, then ``ud`` by the articulated-body algorithm: O(n).
+@njit(inline="always", **UNCOUNTED)
+def articulated_accelerations(tree, body, state, loads, motion, work, ud, scratch):
+    """Kinematics, loads, then ``ud`` by the articulated-body algorithm: O(n).  The groups
+    as ``jourdain_accelerations``'s, except ``body`` (``mass, com, inertia, gravity``) and
+    ``work`` (``IA, pA, cb, U, Dl, acc``, the algorithm's workspace).
 
-    ``own_ptr``/``own_idx`` list each frame's own speed columns only (in place of the
-    ancestor lists), so that the kinematics skip the O(n depth) inheritance of Jacobian
-    columns the algorithm does not read.  Returns -1 on success, the speed where a
+    ``tree`` ends with ``own_ptr``/``own_idx``: each frame's own speed columns only (in
+    place of the ancestor lists), so that the kinematics skip the O(n depth) inheritance of
+    Jacobian columns the algorithm does not read.  Returns -1 on success, the speed where a
     degree of freedom has no inertia, or -2 when ``ud`` holds NaN or Inf.
     """
+    parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr, own_idx = tree
+    mass, com, inertia, gravity = body
+    qfull, ufull, udfull = state
+    (load_body, load_point, load_force, load_moment, load_in_body, force_int, force_data,
+     switches) = loads
+    R, r, w, v, alpha, a, JR, JT, F, N = motion
+    IA, pA, cb, U, Dl, acc = work
     kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr, own_idx,
                          mass, com, gravity, qfull, ufull, udfull,
                          load_body, load_point, load_force, load_moment, load_in_body,
@@ -161,12 +177,11 @@ def newton_euler_tree(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr
     """The Newton-Euler equations with reaction unknowns solved in tree order: speed rates
     ``ud`` and reaction components ``lam`` (as ``newton_euler_solution``'s ``x``), in O(n).
     Returns as ``articulated_accelerations`` (-2 also for non-finite reactions)."""
-    pivot = articulated_accelerations(parent, kind, axis, seq, pos, C, qoff, uoff, ucol,
-                                      own_ptr, own_idx, mass, com, inertia, gravity, qfull,
-                                      ufull, udfull, load_body, load_point, load_force,
-                                      load_moment, load_in_body, force_int, force_data,
-                                      switches, R, r, w, v, alpha, a, JR, JT, F, N, IA, pA, cb,
-                                      U, Dl, acc, ud, scratch)
+    pivot = articulated_accelerations(
+        (parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr, own_idx),
+        (mass, com, inertia, gravity), (qfull, ufull, udfull),
+        (load_body, load_point, load_force, load_moment, load_in_body, force_int, force_data,
+         switches), (R, r, w, v, alpha, a, JR, JT, F, N), (IA, pA, cb, U, Dl, acc), ud, scratch)
     if pivot != -1:
         return pivot
     joint_wrenches_tree(parent, r, IA, pA, acc, wrench, scratch)

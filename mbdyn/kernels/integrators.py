@@ -51,8 +51,8 @@ def _accelerations_route(tree, body, loads, ws, ud):
     if len(ws) == 17:
         def jourdain_route(tree, body, loads, ws, ud):
             (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, F, N, M, f, L, scratch) = ws
-            return jourdain_accelerations(*tree, *body, qfull, ufull, udfull, *loads,
-                                          R, r, w, v, alpha, a, JR, JT, F, N, M, f, L, ud,
+            return jourdain_accelerations(tree, body, (qfull, ufull, udfull), loads,
+                                          (R, r, w, v, alpha, a, JR, JT, F, N), (M, f, L, ud),
                                           scratch)
         return jourdain_route
 
@@ -60,9 +60,10 @@ def _accelerations_route(tree, body, loads, ws, ud):
         (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, F, N, IA, pA, cb, U, Dl,
          acc, scratch) = ws
         mass, com, inertia, _, gravity = body
-        return articulated_accelerations(*tree, mass, com, inertia, gravity, qfull, ufull,
-                                         udfull, *loads, R, r, w, v, alpha, a, JR, JT, F, N,
-                                         IA, pA, cb, U, Dl, acc, ud, scratch)
+        return articulated_accelerations(tree, (mass, com, inertia, gravity),
+                                         (qfull, ufull, udfull), loads,
+                                         (R, r, w, v, alpha, a, JR, JT, F, N),
+                                         (IA, pA, cb, U, Dl, acc), ud, scratch)
     return articulated_route
 
 

@@ -159,7 +159,7 @@ def jourdain_accelerations_packed(fb, ib, t, q, u):
     return value; ``u'`` is left in the ``ud`` view)."""
     _scatter(fb, ib, t, q, u)
     tree, body, state, loads, _, motion, jourdain, _, _, scratch = _views(fb, ib, t)
-    return jourdain_accelerations(*tree, *body, *state, *loads, *motion, *jourdain, scratch)
+    return jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch)
 
 
 @njit(**UNCOUNTED)
@@ -169,7 +169,7 @@ def state_derivative_packed(fb, ib, t, y, ydot):
     nq = t[7]
     _scatter(fb, ib, t, y[:nq], y[nq:])
     tree, body, state, loads, _, motion, jourdain, _, _, scratch = _views(fb, ib, t)
-    pivot = jourdain_accelerations(*tree, *body, *state, *loads, *motion, *jourdain, scratch)
+    pivot = jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch)
     if pivot >= 0:
         return pivot
     return _state_rates(fb, ib, t, y, ydot)
@@ -212,8 +212,8 @@ def articulated_accelerations_packed(fb, ib, t, q, u):
     _scatter(fb, ib, t, q, u)
     tree, body, state, loads, _, motion, jourdain, _, art, scratch = _views(fb, ib, t)
     mass, com, inertia, _, gravity = body
-    return articulated_accelerations(*tree[:9], *art[:2], mass, com, inertia, gravity, *state,
-                                     *loads, *motion, *art[2:8], jourdain[3], scratch)
+    return articulated_accelerations(tree[:9] + art[:2], (mass, com, inertia, gravity), state,
+                                     loads, motion, art[2:8], jourdain[3], scratch)
 
 
 @njit(**UNCOUNTED)
