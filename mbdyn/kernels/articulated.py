@@ -92,6 +92,59 @@ def _add_shifted_inertia(IA, i, p, rho, Y):
         IA[p, 5, col] += l2
 
 
+@njit(cache=True, inline="always")
+def _ball_joint_inertia(IA, pA, U, Dl, inv, cb, i, V):
+    """``Ia`` into ``IA[i]`` and ``pa`` into ``pA[i]`` behind a ball joint (three speeds,
+    ``U = IA S`` and ``D``'s factor and ``D^-1 (-S^T pA)`` in ``U[i]``, ``Dl[i]``): its
+    ``S`` spans every rotation and no translation, so ``Ia`` has no rotational rows or
+    columns and ``pa`` no moment (a ball joint passes none about its centre) -- zero
+    exactly rather than to rounding; the translational rows as the general case's.  ``V``
+    (6x3) is scratch."""
+    for a_ in range(3, 6):
+        for j in range(3):
+            s = U[i, a_, j]
+            for l_ in range(j):
+                s -= Dl[i, j, l_] * V[a_, l_]
+            V[a_, j] = s * inv[i, j]
+    for a_ in range(3, 6):
+        for b_ in range(a_, 6):
+            IA[i, a_, b_] -= V[a_, 0] * V[b_, 0] + V[a_, 1] * V[b_, 1] + V[a_, 2] * V[b_, 2]
+            IA[i, b_, a_] = IA[i, a_, b_]
+    for a_ in range(3):
+        pA[i, a_] = 0.0
+        for b_ in range(6):
+            IA[i, a_, b_] = 0.0
+            IA[i, b_, a_] = 0.0
+    for a_ in range(3, 6):
+        pA[i, a_] += (U[i, a_, 0] * Dl[i, 0, 6] + U[i, a_, 1] * Dl[i, 1, 6]
+                      + U[i, a_, 2] * Dl[i, 2, 6]
+                      + IA[i, a_, 3] * cb[i, 3] + IA[i, a_, 4] * cb[i, 4]
+                      + IA[i, a_, 5] * cb[i, 5])
+
+
+@njit(cache=True, inline="always")
+def _add_shifted_translational_inertia(IA, i, p, rho, T):
+    """``_add_shifted_inertia`` for an articulated inertia that has only its translational
+    block ``C`` (behind a ball joint): ``X^T IA[i] X = [[-P T, -T^T], [-T, C]]`` with
+    ``P = [rho]x`` and ``T = C P`` (``P C = -T^T``: ``C`` symmetric, ``P`` skew).  ``T``
+    (3x3) is scratch."""
+    x, y, z = rho[0], rho[1], rho[2]
+    for a_ in range(3):
+        # row a_ of T = C P, with P = [[0, -z, y], [z, 0, -x], [-y, x, 0]]
+        c0, c1, c2 = IA[i, 3 + a_, 3], IA[i, 3 + a_, 4], IA[i, 3 + a_, 5]
+        T[a_, 0] = c1 * z - c2 * y
+        T[a_, 1] = c2 * x - c0 * z
+        T[a_, 2] = c0 * y - c1 * x
+    for b_ in range(3):
+        IA[p, 0, b_] += z * T[1, b_] - y * T[2, b_]
+        IA[p, 1, b_] += x * T[2, b_] - z * T[0, b_]
+        IA[p, 2, b_] += y * T[0, b_] - x * T[1, b_]
+        for a_ in range(3):
+            IA[p, 3 + a_, b_] -= T[a_, b_]
+            IA[p, b_, 3 + a_] -= T[a_, b_]
+            IA[p, 3 + a_, 3 + b_] += IA[i, 3 + a_, 3 + b_]
+
+
 @njit(**UNCOUNTED)
 def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a_b, JR, JT,
                      F, N, IA, pA, cb, U, Dl, acc, ud, work):
@@ -175,6 +228,7 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
         col0 = ucol[i]
         kd = kind[i]
         k = NU[kd] if col0 >= 0 else 0
+        ball = k > 0 and kd == SPHERICAL
         if k:
             # U = IA S, D = S^T U, and D's Cholesky factor in Dl[i, :k, :k].  A joint that
             # only turns about the frame's origin (revolute, Euler angles, spherical) has
@@ -219,38 +273,45 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
                 Dl[i, j, 6] = v6[j]
             # Ia = IA - U D^-1 U^T = IA - V^T V with V = L^-1 U^T (one triangular solve
             # per row of U, not two); pa = pA + Ia c + U D^-1 (-S^T pA)
-            V = Y                                            # (6 x 3 scratch: k <= 3 here)
-            if k > 3:
-                V = Vbig
-            for a_ in range(6):
-                for j in range(k):
-                    s = U[i, a_, j]
-                    for l_ in range(j):
-                        s -= Dl[i, j, l_] * V[a_, l_]
-                    V[a_, j] = s * inv[i, j]
-            for a_ in range(6):
-                for b_ in range(a_, 6):
+            if ball:
+                _ball_joint_inertia(IA, pA, U, Dl, inv, cb, i, Y)
+            else:
+                V = Y                                        # (6 x 3 scratch: k <= 3 here)
+                if k > 3:
+                    V = Vbig
+                for a_ in range(6):
+                    for j in range(k):
+                        s = U[i, a_, j]
+                        for l_ in range(j):
+                            s -= Dl[i, j, l_] * V[a_, l_]
+                        V[a_, j] = s * inv[i, j]
+                for a_ in range(6):
+                    for b_ in range(a_, 6):
+                        s = 0.0
+                        for j in range(k):
+                            s += V[a_, j] * V[b_, j]
+                        IA[i, a_, b_] -= s
+                        if b_ != a_:
+                            IA[i, b_, a_] = IA[i, a_, b_]
+                for a_ in range(6):
                     s = 0.0
                     for j in range(k):
-                        s += V[a_, j] * V[b_, j]
-                    IA[i, a_, b_] -= s
-                    if b_ != a_:
-                        IA[i, b_, a_] = IA[i, a_, b_]
+                        s += U[i, a_, j] * Dl[i, j, 6]
+                    pA[i, a_] += s
+        if not ball:
             for a_ in range(6):
                 s = 0.0
-                for j in range(k):
-                    s += U[i, a_, j] * Dl[i, j, 6]
+                for b_ in range(6):
+                    s += IA[i, a_, b_] * cb[i, b_]
                 pA[i, a_] += s
-        for a_ in range(6):
-            s = 0.0
-            for b_ in range(6):
-                s += IA[i, a_, b_] * cb[i, b_]
-            pA[i, a_] += s
         p = parent[i]
         if p >= 0:
             for a_ in range(3):
                 rho[a_] = r[i, a_] - r[p, a_]
-            _add_shifted_inertia(IA, i, p, rho, Y)
+            if ball:
+                _add_shifted_translational_inertia(IA, i, p, rho, Iw)     # Iw: 3x3 scratch
+            else:
+                _add_shifted_inertia(IA, i, p, rho, Y)
             f0, f1, f2 = pA[i, 3], pA[i, 4], pA[i, 5]
             pA[p, 0] += pA[i, 0] + rho[1] * f2 - rho[2] * f1
             pA[p, 1] += pA[i, 1] + rho[2] * f0 - rho[0] * f2
