@@ -32,8 +32,9 @@ from .kernels.kinematics import point_jacobian
 #: textbook writes it, assembled dense and solved by LU
 METHODS = ("jourdain", "articulated", "newton-euler", "newton-euler-dense")
 #: "auto" takes the articulated-body route from this many free speeds on (below it the
-#: mass matrix and its Cholesky factor are cheaper; benchmarks/forward_dynamics.py)
-ARTICULATED_FROM = 8
+#: mass matrix and its Cholesky factor are as cheap or cheaper: at 4 speeds the two cost
+#: the same, at 6 the articulated bodies 7-11 % less; docs/performance.md)
+ARTICULATED_FROM = 6
 
 
 def _perpendicular_pair(a):
