@@ -90,6 +90,7 @@ class CompiledCondition:
             self._stack = np.empty(STACK)
         y = np.concatenate((np.asarray(q, dtype=float).ravel(),
                             np.asarray(u, dtype=float).ravel()))
+        self._check_size(y.shape[0])
         ops, consts = self.program
         return float(evaluate(ops, consts, 0, len(ops), float(t), y, self._stack))
 
@@ -100,16 +101,27 @@ class CompiledCondition:
         if self.program is not None:
             from .kernels.events import condition_rows
             from .kernels.programs import STACK
+            ys = np.ascontiguousarray(ys, dtype=float)
+            if ys.ndim != 2 or len(ys) != len(ts):
+                raise ModelError(f"condition {self.text!r}: expected one state row per time "
+                                 f"({len(ts)}), got states of shape {ys.shape}")
+            self._check_size(ys.shape[1])
             out = np.empty(ts.shape[0])
             ops, consts = self.program
-            condition_rows(ops, consts, 0, len(ops), ts,
-                           np.ascontiguousarray(ys, dtype=float), np.empty(STACK), out)
+            condition_rows(ops, consts, 0, len(ops), ts, ys, np.empty(STACK), out)
             return out
         try:
             v = np.asarray(self.fn(ts, *np.asarray(ys).T), dtype=float)
         except (TypeError, ValueError):
             return None
         return np.broadcast_to(v, ts.shape).copy() if v.shape in ((), ts.shape) else None
+
+    def _check_size(self, size):
+        """The compiled program reads ``y`` unchecked: refuse a state of another size."""
+        if size != len(self.args) - 1:
+            raise ModelError(f"condition {self.text!r}: expected q and u of "
+                             f"{len(self.args) - 1} values in all (the model's coordinates "
+                             f"and speeds), got {size}")
 
     def __getstate__(self):
         return {**self.__dict__, "_fn": None, "_stack": None}

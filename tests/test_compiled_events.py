@@ -145,3 +145,14 @@ def test_an_adaptive_stretch_ends_at_a_crossing_with_its_stages(pendulum):
     K = out[5][0]                                             # the last step's stages
     assert np.allclose(K[0], pendulum.state_derivative(out[0][acc - 2], out[1][acc - 2]),
                        rtol=1e-14, atol=1e-14)
+
+
+def test_a_state_of_the_wrong_size_is_refused_before_the_compiled_program_reads_it(pendulum):
+    g = _condition(pendulum, "theta + theta_dot")
+    assert g(0.0, [0.25], [0.5]) == 0.75
+    with pytest.raises(mb.ModelError, match="expected q and u of 2 values in all.*got 1"):
+        g(0.0, [0.25], [])
+    with pytest.raises(mb.ModelError, match=r"one state row per time \(3\), got states of shape \(2, 2\)"):
+        g.rows(np.zeros(3), np.zeros((2, 2)))
+    with pytest.raises(mb.ModelError, match="got 3"):
+        g.rows(np.zeros(2), np.zeros((2, 3)))
