@@ -207,3 +207,31 @@ def test_help_and_version(capsys):
         assert opt in out
     assert main(["--version"]) == 0
     assert "mbdyn" in capsys.readouterr().out
+
+
+def test_numbas_pedantic_scope_warning_is_not_shown_but_model_warnings_are(capsys):
+    """numba's SSA pass warns "variable ... is not in scope" when it compiles a loop with
+    inlined functions (an internal check of its IR); the command shows every other warning
+    once but not that one."""
+    import types
+    import warnings
+
+    from mbdyn.cli import _dispatch
+    from mbdyn.errors import ModelError, ModelWarning, SimulationError
+
+    class NumbaIRAssumptionWarning(UserWarning):
+        pass
+
+    def command(args):
+        warnings.warn_explicit("\x1b[1mvariable 'x_v1.1' is not in scope.\n\nThis warning "
+                               "came from an internal pedantic check.",
+                               NumbaIRAssumptionWarning, "ssa.py", 304,
+                               module="numba.core.ssa")
+        warnings.warn("body 'b': check the data", ModelWarning)
+        return 0
+
+    assert _dispatch(types.SimpleNamespace(func=command), False, ModelError,
+                     SimulationError) == 0
+    err = capsys.readouterr().err
+    assert "not in scope" not in err
+    assert "mbdyn: warning: body 'b': check the data" in err

@@ -44,6 +44,7 @@ import numpy as np
 
 from .. import limits
 from ..errors import ModelError, SimulationError
+from ..kernels import ignore_pedantic_numba
 from .schedulers import make_scheduler
 
 DEFAULT_QUANTITIES = ("final", "events", "t_final")
@@ -344,9 +345,9 @@ def run_batched(scenes, quantities):
     nfev = np.zeros(m, np.int64)
     with warnings.catch_warnings():
         # numba's parallel lowering reports the evaluation inlined into the prange body
-        # as out of scope (an internal "pedantic check", NumbaIRAssumptionWarning) when it
-        # compiles the call; the members are bit-identical to single runs (tested)
-        warnings.filterwarnings("ignore", message=".*is not in scope")
+        # as out of scope when it compiles the call; the members are bit-identical to
+        # single runs (tested)
+        ignore_pedantic_numba()
         batched_fixed_step(SCHEMES[s["integrator"]], dt, n_full, h_last, Y0, table, last,
                            *model.loop_arguments(model.formulation(s["method"])), Yend, done,
                            status, nfev)

@@ -144,8 +144,10 @@ def main(argv=None):
 
 
 def _dispatch(args, debug, ModelError, SimulationError):
+    from ..kernels import ignore_pedantic_numba
     with warnings.catch_warnings():
         warnings.simplefilter("always")
+        ignore_pedantic_numba()
         seen = set()
 
         def show(message, category, filename, lineno, file=None, line=None):
