@@ -223,10 +223,15 @@ def test_numbas_pedantic_scope_warning_is_not_shown_but_model_warnings_are(capsy
         pass
 
     def command(args):
+        # raised from numba's module, or (a parallel loop) from the kernel's source line
         warnings.warn_explicit("\x1b[1mvariable 'x_v1.1' is not in scope.\n\nThis warning "
                                "came from an internal pedantic check.",
                                NumbaIRAssumptionWarning, "ssa.py", 304,
                                module="numba.core.ssa")
+        warnings.warn_explicit("\x1b[1m\x1b[1m\x1b[1mvariable 'a_route_v127__v108call_45_3.1'"
+                               " is not in scope.\nThis warning came from an internal "
+                               "pedantic check.", NumbaIRAssumptionWarning,
+                               "/x/mbdyn/kernels/batched.py", 58)
         warnings.warn("body 'b': check the data", ModelWarning)
         return 0
 

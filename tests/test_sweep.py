@@ -145,6 +145,16 @@ def test_batched_members_bit_identical_to_single_runs(integrator, t_end, method)
         assert row["t_final"] == res.t[-1] == t_end
 
 
+def test_batched_takes_the_default_quantities_of_a_model_without_events():
+    """``mbdyn sweep --batched`` with no ``-q``: the default quantities include events,
+    which have no columns for a model without them; same table as serial."""
+    grid = {"initial.theta1": [0.1, 2.0]}
+    fixed = {"simulation.integrator": "rk4", "simulation.t_end": 0.05, "simulation.dt": 1e-3}
+    batched = sweep(PENDULUM, grid, fixed=fixed, batched=True)
+    _same(sweep(PENDULUM, grid, fixed=fixed), batched)
+    assert "final.theta1" in batched.columns and "t_final" in batched.columns
+
+
 def test_batched_refuses_what_it_cannot_run():
     with pytest.raises(ModelError, match="events"):
         sweep(TOP, GRID, ("final",), batched=True)

@@ -293,7 +293,7 @@ def batchable(scene, quantities):
     """Why ``scene`` cannot run batched (a sentence), or None if it can: a fixed-step
     integrator, the Jourdain method, no events, no Euler-angle joints (their singularity
     is checked per step), no Python-function loads, quantities among final/t_final/
-    steps/rhs_evaluations."""
+    steps/rhs_evaluations (and events, which has no columns without events)."""
     from ..simulate import FIXED_STEP
     s = scene.settings
     model = scene.model
@@ -310,7 +310,9 @@ def batchable(scene, quantities):
         return "the model has Euler-angle joints (their singularity is checked per step)"
     if model.has_callable_loads:
         return "the model has Python-function loads"
-    bad = [q for q in quantities if q not in ("final", "t_final", "steps", "rhs_evaluations")]
+    # "events" has no columns here: a model with events was refused above
+    bad = [q for q in quantities
+           if q not in ("final", "t_final", "steps", "rhs_evaluations", "events")]
     if bad:
         return f"quantities {bad} need the whole motion; batched runs keep the final state"
     return None
