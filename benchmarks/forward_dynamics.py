@@ -278,7 +278,7 @@ def subkernel_cases(model, q, u, ke):
     m._fill(q, u, 0.0)
     ud = np.empty(m.nu)
     kin = (*m._tree, m._mass, m._com, m.gravity, m._qfull, m._ufull, m._udfull,
-           *m._loads_arrays, *m._kin_out)
+           *m._loads_arrays, *m._kin_out, m._scratch)
     jd = (m._mass, m._com, m._inertia, m._has_inertia, m._R, m._r, m._w, m._alpha, m._a,
           m._JR, m._JT, m._anc_ptr, m._anc_idx, m._parent, m._F, m._N, m._M, m._f)
     ch = (m._M, m._f, m._L, ud)

@@ -145,9 +145,21 @@ def compile_condition(condition, model, name):
     import sympy
 
     from .expressions import ExpressionError, parse_condition, symbol
+    order = ("t",) + model.coordinates + model.speeds
+    if isinstance(condition, CompiledCondition):
+        # compiled for a model: it reads the state by position, so it is recompiled for
+        # another order of coordinates and speeds
+        if tuple(s.name for s in condition.args) == order:
+            return condition, None
+        unknown = sorted(s.name for s in condition.g.free_symbols if s.name not in order)
+        if unknown:
+            raise ModelError(f"event {name!r}: its condition {condition.text!r} uses "
+                             f"{', '.join(unknown)}, which are not t, coordinates or speeds "
+                             "of this model")
+        return sympy_condition(condition.g, model, condition.text), None
     if callable(condition) and not isinstance(condition, sympy.Basic):
         return condition, None
-    names = {n: symbol(n) for n in ("t",) + model.coordinates + model.speeds}
+    names = {n: symbol(n) for n in order}
     names.update({n: symbol(n) for n in model.parameters if n not in names})
     implied = None
     if isinstance(condition, str):

@@ -156,3 +156,24 @@ def test_a_state_of_the_wrong_size_is_refused_before_the_compiled_program_reads_
         g.rows(np.zeros(3), np.zeros((2, 2)))
     with pytest.raises(mb.ModelError, match="got 3"):
         g.rows(np.zeros(2), np.zeros((2, 3)))
+
+
+def test_a_condition_compiled_for_one_model_is_recompiled_for_another_order(pendulum):
+    """A compiled condition reads the state by position: given to a model whose
+    coordinates and speeds come in another order, it is compiled again by name."""
+    s = mb.System("two")
+    s.add_body("a", mass=1.0, com=(0, 0, -L))
+    s.add_joint("phi", "revolute", "ground", "a", axis="x")
+    s.add_body("b", mass=1.0, com=(0, 0, -L))
+    s.add_joint("theta", "revolute", "a", "b", axis="x", position=(0, 0, -L))
+    two = s.compile()
+    g = _condition(pendulum, "theta - 2 * theta_dot")          # pendulum: y = [theta, theta_dot]
+    again = as_event(mb.Event("e", g), two).condition           # two: [phi, theta, phi_dot, ...]
+    assert again is not g
+    assert again(0.0, [0.1, 0.7], [0.2, 0.3]) == pytest.approx(0.7 - 2 * 0.3, abs=1e-15)
+    assert as_event(mb.Event("e", g), pendulum).condition is g   # same order: kept as it is
+    s2 = mb.System("other")
+    s2.add_body("c", mass=1.0, com=(0, 0, -L))
+    s2.add_joint("psi", "revolute", "ground", "c", axis="x")
+    with pytest.raises(mb.ModelError, match="theta.*not t, coordinates or speeds"):
+        as_event(mb.Event("e", g), s2.compile())
