@@ -44,7 +44,6 @@ import numpy as np
 
 from .. import limits
 from ..errors import ModelError, SimulationError
-from ..kernels import ignore_pedantic_numba
 from .schedulers import make_scheduler
 
 DEFAULT_QUANTITIES = ("final", "events", "t_final")
@@ -345,14 +344,11 @@ def run_batched(scenes, quantities):
     done = np.zeros(m, np.int64)
     status = np.zeros(m, np.int64)
     nfev = np.zeros(m, np.int64)
-    with warnings.catch_warnings():
-        # numba's parallel lowering reports the evaluation inlined into the prange body
-        # as out of scope when it compiles the call; the members are bit-identical to
-        # single runs (tested)
-        ignore_pedantic_numba()
-        batched_fixed_step(SCHEMES[s["integrator"]], dt, n_full, h_last, Y0, table, last,
-                           *model.loop_arguments(model.formulation(s["method"])), Yend, done,
-                           status, nfev)
+    # numba's scope warning on compiling this call is filtered by mbdyn.kernels, as for
+    # every compiled loop
+    batched_fixed_step(SCHEMES[s["integrator"]], dt, n_full, h_last, Y0, table, last,
+                       *model.loop_arguments(model.formulation(s["method"])), Yend, done,
+                       status, nfev)
     all_times = np.append(times, t_end) if h_last else times
     rows = []
     for i, sc in enumerate(scenes):
