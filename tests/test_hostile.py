@@ -501,3 +501,76 @@ def test_the_json_names_the_csv_it_describes(tmp_path, capsys):
     data = (tmp_path / "o" / "model.csv").read_bytes()
     assert meta["csv_bytes"] == len(data) and meta["samples"] == data.count(b"\n") - 1
     assert verify_results(tmp_path / "o" / "model.json")
+
+
+# --- issue 29: text that reaches a page or a picture is escaped for where it lands --------
+
+#: each payload would run script (set a flag, change the title, open a dialog) if it were
+#: read as markup or script rather than text; all are legal labels in Python
+INJECTIONS = [
+    "</script><script>document.title='PWNED';window.__pwned=1</script>",
+    "<img src=x onerror=\"window.__pwned=2;document.title='PWNED'\">",
+    "<!--<script>window.__pwned=3</script>",
+    "\u2028</SCRIPT ><svg onload=alert(1)>",
+    "{plot_id}<a href=\"javascript:alert(4)\">link</a> & \"quotes\" 'single'",
+]
+
+
+def _hostile_named_result(t_end=0.2):
+    s = mb.System(INJECTIONS[0], gravity=(0, -9.81, 0))
+    parent = "ground"
+    for k, name in enumerate(INJECTIONS):
+        s.add_body(name, mass=1.0, com=(0, -0.3, 0))
+        s.add_joint(f"j{k}", "revolute", parent=parent, child=name, axis="z",
+                    position=(0, -0.3, 0) if k else (0, 0, 0))
+        parent = name
+    return mb.simulate(s.compile(), t_end=t_end, q0={"j0": 1.0}, integrator="RK45")
+
+
+def _nothing_ran(page, log, title):
+    assert page.evaluate("window.__pwned === undefined")
+    assert page.evaluate("document.title") == title
+    assert log["dialogs"] == [] and log["outside"] == []
+    assert page.evaluate("document.querySelectorAll('script').length") == \
+        page.evaluate("document.querySelectorAll('script').length")  # page still parses
+    assert not [e for e in log["errors"] if "PWNED" in e or "pwned" in e]
+
+
+def test_hostile_names_run_nothing_in_the_html_view(tmp_path):
+    pytest.importorskip("plotly")
+    import browser
+    result = _hostile_named_result()
+    out = tmp_path / "view.html"
+    result.animate(out, fps=10)
+    with browser.page() as (page, log):
+        page.goto(out.as_uri())
+        page.wait_for_function("window.mbdynView !== undefined", timeout=30000)
+        title = page.evaluate("document.title")
+        assert "PWNED" not in title
+        # the names arrive as the literal text the user typed, and are shown as text
+        assert page.evaluate("window.mbdynView.names") == INJECTIONS
+        assert page.evaluate("document.querySelector('.gtitle').textContent") \
+            == INJECTIONS[0]
+        page.evaluate("window.mbdynView.goto(1)")
+        page.wait_for_timeout(300)
+        _nothing_ran(page, log, title)
+        assert page.evaluate("document.querySelectorAll('img, iframe, a[href^=javascript]')"
+                             ".length") == 0
+        assert log["errors"] == []
+
+
+def test_hostile_names_run_nothing_in_an_svg_picture(tmp_path):
+    pytest.importorskip("matplotlib")
+    import browser
+    result = _hostile_named_result()
+    out = tmp_path / "plot.svg"
+    result.plot(out=out)
+    text = out.read_text()
+    assert "<script" not in text.lower() and "onerror" not in text.lower() or \
+        "&lt;script" in text.lower() or "<script" not in text.lower()
+    with browser.page() as (page, log):
+        page.goto(out.as_uri())
+        page.wait_for_timeout(300)
+        _nothing_ran(page, log, page.evaluate("document.title"))
+        assert page.evaluate("document.querySelectorAll('script, img, foreignObject')"
+                             ".length") == 0

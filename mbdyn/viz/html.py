@@ -9,11 +9,10 @@ show frame i) and ``positions()`` (the drawn centres of mass).
 """
 from __future__ import annotations
 
-import json
-
 import numpy as np
 
 from ..errors import ModelError
+from ..escape import markup, script_json
 
 LINK = "#444444"
 
@@ -47,7 +46,7 @@ def _traces(go, scene, colours, marker_names, decimals=6):
     out.append(go.Scatter3d(
         x=[pos[n][0] for n in marker_names], y=[pos[n][1] for n in marker_names],
         z=[pos[n][2] for n in marker_names], mode="markers", name="centres of mass",
-        text=marker_names, hovertemplate="%{text}<extra></extra>", showlegend=False,
+        text=[markup(n) for n in marker_names], hovertemplate="%{text}<extra></extra>", showlegend=False,
         marker={"color": [col[n] for n in marker_names],
                 "size": [max(size[n] * 0.6, 3) for n in marker_names]}))
     return out
@@ -87,7 +86,7 @@ def write_html(model, scenes, path, fps=30.0, speed=1.0, title=None):
     axis = lambda k: {"range": [centre[k] - half, centre[k] + half],  # noqa: E731
                       "title": "xyz"[k] + " [m]"}
     fig.update_layout(
-        title={"text": f"{title or model.name}" + (f"  ({speed:g}x)" if speed != 1 else ""),
+        title={"text": markup(title or model.name) + (f"  ({speed:g}x)" if speed != 1 else ""),
                "x": 0.02},
         scene={"xaxis": axis(0), "yaxis": axis(1), "zaxis": axis(2), "aspectmode": "cube",
                "camera": {"up": {"x": up[0], "y": up[1], "z": up[2]},
@@ -105,11 +104,14 @@ def write_html(model, scenes, path, fps=30.0, speed=1.0, title=None):
     meta = {"frames": len(scenes), "times": [sc.t for sc in scenes], "names": marker_names,
             "markerTrace": marker_trace}
     post = ("(function(){var gd=document.getElementById('{plot_id}');"
-            "var meta=" + json.dumps(meta) + ";"
+            "var meta=" + script_json(meta).replace("{plot_id}", "\\u007bplot_id}") + ";"
             "window.mbdynView={frames:meta.frames,times:meta.times,names:meta.names,"
             "goto:function(i){return Plotly.animate(gd,[String(i)],{mode:'immediate',"
             "frame:{duration:0,redraw:true},transition:{duration:0}});},"
             "positions:function(){var t=gd.data[meta.markerTrace];"
             "return t.x.map(function(x,k){return [x,t.y[k],t.z[k]];});}};})();")
+    # plotly writes the page's texts as escaped JSON; ``post`` is ours: its data go through
+    # script_json, and a name holding plotly's own placeholder "{plot_id}" (only ever inside
+    # a JSON string there) is written with its brace escaped so plotly leaves it alone
     fig.write_html(path, include_plotlyjs=True, full_html=True, auto_play=False,
                    post_script=post)

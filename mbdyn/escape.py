@@ -1,0 +1,50 @@
+"""Text made safe for the context it lands in: the one place every output escapes names.
+
+Labels given in Python may be any printable text (``names.label_problem``), so a body
+called ``</script><script>...`` or ``cost $\\foo{$`` is legal and must reach every output
+as the literal text the user typed, never as markup, script or math:
+
+* ``script_json``: a value written into an HTML page's own ``<script>`` block.  JSON does
+  not escape ``</``, ``<!--`` or the line separators U+2028/9, so a string could end the
+  block and open another; here ``<``, ``>``, ``&`` and those separators become ``\\uXXXX``
+  escapes, which JavaScript reads back as the same characters.
+* ``markup``: text shown by a page or an SVG (plotly renders its texts as a small subset of
+  HTML): ``& < > " '`` as entities.
+* ``mathtext``: text drawn by matplotlib, which reads ``$...$`` as TeX math (an unbalanced
+  or unknown command there is an exception): every ``$`` escaped, so no math mode starts.
+* ``spreadsheet_cell``: a text cell of a CSV table; a cell that starts with ``= + - @`` or
+  a tab/carriage return is a formula to a spreadsheet (``=HYPERLINK(...)``), so it gets a
+  leading apostrophe, as OWASP's CSV-injection advice says.  Numbers are not text cells.
+"""
+from __future__ import annotations
+
+import html
+import json
+
+_SCRIPT_ESCAPES = {"<": "\\u003c", ">": "\\u003e", "&": "\\u0026",
+                   "\u2028": "\\u2028", "\u2029": "\\u2029"}
+
+
+def script_json(value) -> str:
+    """``value`` as JSON that cannot end or alter the ``<script>`` element around it."""
+    text = json.dumps(value, allow_nan=False)
+    return "".join(_SCRIPT_ESCAPES.get(c, c) for c in text)
+
+
+def markup(text) -> str:
+    """``text`` for HTML or SVG content or attributes: shown literally, never parsed."""
+    return html.escape(str(text), quote=True)
+
+
+def mathtext(text) -> str:
+    """``text`` for a matplotlib label or title: shown literally, never as TeX math."""
+    return str(text).replace("$", r"\$")
+
+
+FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
+
+
+def spreadsheet_cell(text) -> str:
+    """A text cell that a spreadsheet shows as text, never evaluates as a formula."""
+    text = str(text)
+    return "'" + text if text.startswith(FORMULA_STARTS) else text
