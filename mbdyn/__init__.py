@@ -19,7 +19,7 @@ _PUBLIC = {
     "Model": ".compile", "Kinematics": ".compile",
     "Result": ".simulate", "Event": ".simulate", "simulate": ".simulate",
     "INTEGRATORS": ".simulate", "FIXED_STEP": ".simulate",
-    "t": ".elements",
+    "t": ".elements.values",
     "ModelError": ".errors", "ModelWarning": ".errors", "NonFiniteError": ".errors",
     "SimulationError": ".errors", "SingularityWarning": ".errors",
     "SingularMassMatrixError": ".errors",
@@ -39,10 +39,17 @@ __all__ = ["System", "Model", "Kinematics", "Result", "Event", "simulate", "iner
            "sweep", "SweepResult"]
 
 
+#: public modules that live deeper in the package -> their module
+_MODULES = {"inertia": ".elements.inertia", "forces": ".elements.forces",
+            "effects": ".elements.effects", "rotations": ".elements.rotations"}
+
+
 def __getattr__(name):
     """Import a public name (or a submodule such as ``viz``) on first use."""
     if name in _PUBLIC:
         value = getattr(importlib.import_module(_PUBLIC[name], __name__), name)
+    elif name in _MODULES:
+        value = importlib.import_module(_MODULES[name], __name__)
     else:
         try:
             value = importlib.import_module(f".{name}", __name__)

@@ -144,7 +144,7 @@ def compile_condition(condition, model, name):
     function."""
     import sympy
 
-    from .expressions import ExpressionError, parse_condition, symbol
+    from .elements.expressions import ExpressionError, parse_condition, symbol
     order = ("t",) + model.coordinates + model.speeds
     if isinstance(condition, CompiledCondition):
         # compiled for a model: it reads the state by position, so it is recompiled for

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from .errors import ModelError
-from .forces import BEARING_COEFFICIENTS, Table
+from .elements.forces import BEARING_COEFFICIENTS, Table
 from .kernels import forces as kf
 
 

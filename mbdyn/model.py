@@ -13,12 +13,14 @@ import numpy as np
 import sympy
 
 from .compile import Model
-from .effects import parse_effects, warn_if_unphysical
-from .elements import (has_symbols, inertia_tensor, make_body, make_joint, make_load,
-                       numeric)
+from .elements.effects import parse_effects, warn_if_unphysical
+from .elements.values import has_symbols, numeric
+from .elements.bodies import inertia_tensor, make_body
+from .elements.joints import make_joint
+from .elements.loads import make_load
 from .errors import ModelError, ModelWarning, SingularMassMatrixError
 from .names import identifier_problem, label_problem
-from .forces import GLOBAL_EFFECTS, make_force
+from .elements.forces import GLOBAL_EFFECTS, make_force
 
 GROUND = "ground"
 

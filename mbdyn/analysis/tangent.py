@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..kernels.joints import KIND_CODES
-from ..rotations import product as quaternion_product
+from ..elements.rotations import product as quaternion_product
 
 SPHERICAL, FREE = KIND_CODES["spherical"], KIND_CODES["free"]
 

@@ -54,7 +54,7 @@ def describe(scene):
         if np.any(j.position):
             entry["position"] = j.position.tolist()
         if np.abs(j.orientation - np.eye(3)).max() > 0:
-            from ..rotations import from_matrix
+            from ..elements.rotations import from_matrix
             entry["orientation"] = from_matrix(j.orientation).tolist()
         if j.drive is not None:
             entry["drive"] = str(spec["drive"])

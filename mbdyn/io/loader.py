@@ -24,7 +24,7 @@ import sympy
 
 from .. import compile as _compile
 from .. import limits
-from ..elements import t as TIME
+from ..elements.values import t as TIME
 from ..errors import ModelError, ModelWarning
 from ..model import GROUND, System
 from ..simulate import DEFAULTS as SIMULATE_DEFAULTS
@@ -608,7 +608,7 @@ class _SceneBuilder:
 
     def effects(self):
         """The file's ``[effects]`` then the caller's switches, checked by name."""
-        from ..effects import parse_effects
+        from ..elements.effects import parse_effects
         known = self.system.effect_names()
         with self.engine(("effects",)):
             state = parse_effects(self.doc.get("effects"), known, f"{self.file}: effects")

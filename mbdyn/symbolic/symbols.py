@@ -13,7 +13,7 @@ import math
 import numpy as np
 import sympy
 
-from ..elements import t as TIME
+from ..elements.values import t as TIME
 from ..errors import ModelError
 
 __all__ = ["TIME", "exact", "exact_vector", "exact_matrix", "canonical", "rotation_about_axis",

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .elements import parse_axis, parse_sequence
-from .errors import ModelError
+from ..errors import ModelError
+from .values import parse_axis, parse_sequence
 
 
 def from_axis_angle(axis, angle):

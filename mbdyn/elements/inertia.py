@@ -5,7 +5,7 @@ results are 3x3 tensors in body axes (kg m^2).
 """
 import numpy as np
 
-from .errors import ModelError
+from ..errors import ModelError
 
 
 def _nonnegative(shape, **values):

@@ -24,9 +24,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .elements import _vector3, has_symbols, numeric, parse_axis
-from .errors import ModelError
-from .names import identifier_problem
+from ..errors import ModelError
+from ..names import identifier_problem
+from .values import _vector3, has_symbols, numeric, parse_axis
 
 KINDS = ("spring-damper", "joint-spring-damper", "bushing", "bearing", "contact")
 INTERPOLATIONS = ("pchip", "linear")
@@ -74,7 +74,7 @@ class Table:
 
     def __call__(self, x):
         """The interpolant at ``x`` (numpy; for reports and tests)."""
-        from .kernels.forces import table_eval
+        from ..kernels.forces import table_eval
         blk = self.block()
         out = np.empty(3)
         table_eval(blk, 0, self.mode, float(x), out)

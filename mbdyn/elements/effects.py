@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import warnings
 
-from .errors import ModelError, ModelWarning
+from ..errors import ModelError, ModelWarning
 
 GLOBAL = ("gravity", "gyroscopic")
 

@@ -18,7 +18,7 @@ import math
 
 import sympy
 
-from . import limits
+from .. import limits
 
 #: Functions an expression may call: name -> (sympy function, allowed numbers of arguments).
 FUNCTIONS = {
