@@ -9,16 +9,16 @@ anything.  Each public name is imported from its module on first use (PEP 562), 
 ``mb.System``, ``mb.derive`` or ``mb.viz`` load only what they need.
 """
 import importlib
-import types
 
 __version__ = "0.1.0"
 
 #: public name -> the module that defines it (relative to this package)
 _PUBLIC = {
-    "System": ".model", "GROUND": ".model",
-    "Model": ".compile", "Kinematics": ".compile",
-    "Result": ".simulate", "Event": ".simulate", "simulate": ".simulate",
-    "INTEGRATORS": ".simulate", "FIXED_STEP": ".simulate",
+    "System": ".assembly.system", "GROUND": ".assembly.system",
+    "Model": ".compiled.model", "Kinematics": ".algorithms.kinematics",
+    "Result": ".integrate.result", "Event": ".integrate.events",
+    "simulate": ".integrate.simulation", "INTEGRATORS": ".integrate.settings",
+    "FIXED_STEP": ".integrate.settings",
     "t": ".elements.values",
     "ModelError": ".errors", "ModelWarning": ".errors", "NonFiniteError": ".errors",
     "SimulationError": ".errors", "SingularityWarning": ".errors",
@@ -64,15 +64,3 @@ def __getattr__(name):
 def __dir__():
     return sorted(set(globals()) | set(__all__))
 
-
-class _Package(types.ModuleType):
-    """The package's module type: importing the submodule ``mbdyn.simulate`` binds it as
-    the package attribute ``simulate``; the public name is the function, as before."""
-
-    def __setattr__(self, name, value):
-        if name == "simulate" and isinstance(value, types.ModuleType):
-            value = value.simulate
-        super().__setattr__(name, value)
-
-
-__import__("sys").modules[__name__].__class__ = _Package

@@ -11,12 +11,12 @@ import mbdyn as mb
 import importlib
 from mbdyn.io import load_model
 from mbdyn.kernels import adaptive as ka
-from mbdyn.programs import EventPrograms
+from mbdyn.compiled.programs import EventPrograms
 
 from closed_forms import quaternion_zxz
 from textbook_systems import DOUBLE_PENDULUM_DATA, TOP_DATA, double_pendulum_system, top_system
 
-sim = importlib.import_module("mbdyn.simulate")
+budgets = importlib.import_module("mbdyn.integrate.budget")
 MODELS = __import__("pathlib").Path(__file__).resolve().parents[1] / "models"
 PAIRS = ("RK45", "DOP853")
 
@@ -228,7 +228,7 @@ def test_max_steps_and_max_samples_stop_where_scipys_path_stops(pendulum, integr
 
 
 def test_the_step_projection_trips_as_on_scipys_path(pendulum, monkeypatch):
-    monkeypatch.setattr(sim, "PROJECTION_STEPS", 50)
+    monkeypatch.setattr(budgets, "PROJECTION_STEPS", 50)
     for integrator in ("DOP853", "scipy-DOP853"):
         with pytest.raises(mb.SimulationError, match="would need about") as info:
             mb.simulate(pendulum, 40.0, P0, integrator=integrator, max_steps=2000)
@@ -313,7 +313,7 @@ def test_driven_models_run_compiled_and_agree_with_scipy(integrator):
 def test_drive_programs_evaluate_as_the_drives_do():
     from mbdyn.elements.joints import make_drive
     from mbdyn.kernels.programs import STACK, drive_values
-    from mbdyn.programs import drive_programs
+    from mbdyn.compiled.programs import drive_programs
     t = mb.t
     exprs = (3 * t, sp.sin(2 * t) ** 2 + sp.exp(-t / 3) * sp.cos(t),
              sp.Rational(1, 2) * t ** 2 - sp.pi * t, sp.sqrt(t + 1) + sp.log(t + 2) + sp.atan(t),

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import mbdyn as mb
-from mbdyn.compile import ARTICULATED_FROM
+from mbdyn.algorithms.forward_dynamics import ARTICULATED_FROM
 from ball_chain import ball_chain, reference_accelerations
 from random_trees import StateLoad, build_system, cached_tree
 

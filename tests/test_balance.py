@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scipy.integrate import cumulative_simpson as scipy_cumulative_simpson
 
-from mbdyn.balance import cumulative_simpson
+from mbdyn.integrate.balance import cumulative_simpson
 
 
 @pytest.mark.parametrize("n", [3, 4, 5, 8, 33])

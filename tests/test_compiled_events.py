@@ -10,9 +10,9 @@ import pytest
 import sympy as sp
 
 import mbdyn as mb
-from mbdyn.events import as_event
+from mbdyn.integrate.events import as_event
 from mbdyn.kernels import adaptive as ka
-from mbdyn.programs import EventPrograms
+from mbdyn.compiled.programs import EventPrograms
 
 L, THETA0 = 0.8, 1.0
 

@@ -240,7 +240,7 @@ def test_vectorized_singularity_watch_matches_the_step_by_step_one(stretches):
     """Fixed-step runs check whole stretches of steps at once (``check_rows``); it must
     stop at the same row, with the same message, closest approach and warnings, as the
     one-step check the adaptive runs use."""
-    from mbdyn.simulate import _Monitor
+    from mbdyn.integrate.monitor import Monitor as _Monitor
     model = top("euler")
     ts = np.linspace(0.0, 0.1, 100)
     ys = np.zeros((100, 6))

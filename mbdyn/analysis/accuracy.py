@@ -19,7 +19,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ModelError, SimulationError
-from ..simulate import ADAPTIVE, FIXED_STEP, simulate
+from ..integrate.settings import ADAPTIVE, FIXED_STEP
+from ..integrate.simulation import simulate
 
 REFERENCE = ("DOP853", 1e-13)
 #: a reference whose cross-check differs by more than this cannot score errors below it

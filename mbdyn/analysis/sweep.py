@@ -293,7 +293,7 @@ def batchable(scene, quantities):
     integrator, the Jourdain method, no events, no Euler-angle joints (their singularity
     is checked per step), no Python-function loads, quantities among final/t_final/
     steps/rhs_evaluations (and events, which has no columns without events)."""
-    from ..simulate import FIXED_STEP
+    from ..integrate.settings import FIXED_STEP
     s = scene.settings
     model = scene.model
     if s["integrator"] not in FIXED_STEP:

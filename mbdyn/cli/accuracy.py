@@ -8,7 +8,7 @@ import sys
 from . import SUMMARIES
 from ..analysis.accuracy import DEFAULT_INTEGRATORS, TOLERANCES, accuracy_study
 from ..errors import ModelError
-from ..simulate import INTEGRATORS
+from ..integrate.settings import INTEGRATORS
 from .common import add_model_arguments, load, positive, positive_int
 
 

@@ -10,7 +10,7 @@ from .. import limits
 from ..errors import ModelWarning, SimulationError
 from ..io.loader import METHODS
 from ..io.results import summary, write_results
-from ..simulate import FIXED_STEP, INTEGRATORS
+from ..integrate.settings import FIXED_STEP, INTEGRATORS
 from .common import Progress, add_model_arguments, fmt, load
 
 #: options that are shorthands of --set simulation.KEY=VALUE

@@ -14,16 +14,8 @@ from ..errors import ModelError, NonFiniteError
 from ..kernels.joints import KIND_CODES, NQ, NU
 from ..names import identifier_problem
 from .expressions import RESERVED
-from .values import (
-    _vector3,
-    has_symbols,
-    numeric,
-    parse_axis,
-    parse_orientation,
-    parse_sequence,
-    substitute,
-    t,
-)
+from .values import (_vector3, has_symbols, numeric, parse_axis, parse_orientation,
+                     parse_sequence, substitute, t)
 
 
 @dataclass(frozen=True)

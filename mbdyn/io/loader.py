@@ -22,15 +22,17 @@ import warnings
 import numpy as np
 import sympy
 
-from .. import compile as _compile
+from ..algorithms.forward_dynamics import METHODS as _METHODS
 from .. import limits
 from ..elements.values import t as TIME
 from ..errors import ModelError, ModelWarning
-from ..model import GROUND, System
-from ..simulate import DEFAULTS as SIMULATE_DEFAULTS
-from ..simulate import FIXED_STEP, INTEGRATORS, Event, Result
-from ..simulate import simulate as _simulate
-from ..events import sympy_condition as _condition
+from ..assembly.system import GROUND, System
+from ..integrate.settings import DEFAULTS as SIMULATE_DEFAULTS
+from ..integrate.settings import FIXED_STEP, INTEGRATORS
+from ..integrate.events import Event
+from ..integrate.result import Result
+from ..integrate.simulation import simulate as _simulate
+from ..integrate.events import sympy_condition as _condition
 from .errors import ModelFileError
 from .expressions import ExpressionError, parse, parse_condition, symbol, to_float
 from .schema import (DIRECTIONS, Checker, _suggest, apply_case, apply_override,
@@ -38,7 +40,7 @@ from .schema import (DIRECTIONS, Checker, _suggest, apply_case, apply_override,
 
 #: The formulations a run can use -- the one list behind ``[simulation] method`` and
 #: ``mbdyn run --method``.  Extend it here when a formulation is added.
-METHODS = ("auto",) + tuple(_compile.METHODS) + ("symbolic",)
+METHODS = ("auto",) + tuple(_METHODS) + ("symbolic",)
 
 #: ``[simulation]`` defaults.
 DEFAULT_SIMULATION = dict(SIMULATE_DEFAULTS)     # one set of defaults (mbdyn.simulate)

@@ -31,7 +31,7 @@ from .walk import FRAMES, Walk
 
 
 def _as_model(model_or_system):
-    from ..compile import Model
+    from ..compiled.model import Model
     if isinstance(model_or_system, Model):
         return model_or_system
     if hasattr(model_or_system, "compile") and hasattr(model_or_system, "add_joint"):

@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 import sympy
 
-from ..compile import reaction_basis
+from ..compiled.layout import reaction_basis
 from ..errors import ModelError
 from .simplify import diff
 from .symbols import cross, exact_vector

@@ -15,21 +15,10 @@ import tempfile
 import numpy as np
 
 from ..errors import ModelError
-from .geometry import bounds, frames, sample_times
+from .geometry import bounds, frames, sample_times, up_rotation
 
 FORMATS = (".gif", ".mp4", ".html")
 MAX_FRAMES = 3000
-
-
-def up_rotation(model):
-    """A rotation whose third row is "up" (against gravity; z if there is none)."""
-    g = np.asarray(model.gravity, float)
-    up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0 else np.array([0.0, 0.0, 1.0])
-    helper = np.eye(3)[np.argmin(np.abs(up))]
-    e1 = np.cross(helper, up)
-    e1 /= np.linalg.norm(e1)
-    e2 = np.cross(up, e1)
-    return np.array([e1, e2, up])
 
 
 def check_output(path):

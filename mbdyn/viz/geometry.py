@@ -175,3 +175,14 @@ def bounds(scenes):
     centre = 0.5 * (lo + hi)
     half = max(0.5 * float((hi - lo).max()), 1e-3) * 1.1
     return centre, half
+
+
+def up_rotation(model):
+    """A rotation whose third row is "up" (against gravity; z if there is none)."""
+    g = np.asarray(model.gravity, float)
+    up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0 else np.array([0.0, 0.0, 1.0])
+    helper = np.eye(3)[np.argmin(np.abs(up))]
+    e1 = np.cross(helper, up)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(up, e1)
+    return np.array([e1, e2, up])

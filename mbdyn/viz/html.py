@@ -67,8 +67,7 @@ def write_html(model, scenes, path, fps=30.0, speed=1.0, title=None):
     except ImportError:
         raise ModelError("the HTML view needs plotly (it ships plotly.js inside the file): "
                          "pip install \"mbdyn[viz]\"") from None
-    from .animate import up_rotation
-    from .geometry import bounds
+    from .geometry import bounds, up_rotation
     colours = list(dict.fromkeys(c for sc in scenes for _, c, _ in sc.lines))
     marker_names = [name for name, _, _, _ in scenes[0].markers]
     centre, half = bounds(scenes)

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..analysis.tangent import Tangent
 from ..errors import ModelError
-from ..simulate import Result
+from ..integrate.result import Result
 from .animate import animate
 
 

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import ModelError
+from ..errors import ModelError
 
 
 @dataclass(frozen=True)
@@ -68,7 +68,7 @@ class CompiledCondition:
     ``None``)."""
 
     def __init__(self, g, args, text):
-        from .programs import condition_program
+        from ..compiled.programs import condition_program
         self.g, self.args, self.text = g, tuple(args), text
         self.program = condition_program(g, {s.name: k for k, s in enumerate(self.args[1:])})
         self._fn = None
@@ -85,7 +85,7 @@ class CompiledCondition:
     def __call__(self, t, q, u):
         if self.program is None:
             return float(self.fn(t, *q, *u))
-        from .kernels.programs import STACK, evaluate
+        from ..kernels.programs import STACK, evaluate
         if self._stack is None:
             self._stack = np.empty(STACK)
         y = np.concatenate((np.asarray(q, dtype=float).ravel(),
@@ -99,8 +99,8 @@ class CompiledCondition:
         ``[q, u]``); ``None`` when it cannot be evaluated on whole columns."""
         ts = np.ascontiguousarray(ts, dtype=float)
         if self.program is not None:
-            from .kernels.events import condition_rows
-            from .kernels.programs import STACK
+            from ..kernels.events import condition_rows
+            from ..kernels.programs import STACK
             ys = np.ascontiguousarray(ys, dtype=float)
             if ys.ndim != 2 or len(ys) != len(ts):
                 raise ModelError(f"condition {self.text!r}: expected one state row per time "
@@ -144,7 +144,7 @@ def compile_condition(condition, model, name):
     function."""
     import sympy
 
-    from .elements.expressions import ExpressionError, parse_condition, symbol
+    from ..elements.expressions import ExpressionError, parse_condition, symbol
     order = ("t",) + model.coordinates + model.speeds
     if isinstance(condition, CompiledCondition):
         # compiled for a model: it reads the state by position, so it is recompiled for

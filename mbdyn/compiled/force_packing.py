@@ -7,9 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import ModelError
-from .elements.forces import BEARING_COEFFICIENTS, Table
-from .kernels import forces as kf
+from ..errors import ModelError
+from ..elements.forces import BEARING_COEFFICIENTS, Table
+from ..kernels import forces as kf
 
 
 def _frame(model, name, element):
@@ -133,7 +133,7 @@ def warn_outside_tables(model, t, u):
     motion (times ``t``, free speeds ``u`` row by row): the coefficients are held at the
     table's end values there, which is a guess."""
     import warnings
-    from .errors import ModelWarning
+    from ..errors import ModelWarning
     for el in model._force_elements:
         if el.kind != "bearing" or el.params["speeds"] is None or not len(t):
             continue

@@ -16,9 +16,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .errors import ModelError
-from .kernels import packed as kp
-from .kernels.views import UNCOUNTED, c_view
+from ..errors import ModelError
+from ..kernels import packed as kp
+from ..kernels.views import UNCOUNTED, c_view
 
 _ARRAY, _F64 = np.ndarray, np.dtype(np.float64)
 

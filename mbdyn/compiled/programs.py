@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import sympy
 
-from .kernels import programs as kp
+from ..kernels import programs as kp
 
 _UNARY = {sympy.sin: kp.SIN, sympy.cos: kp.COS, sympy.tan: kp.TAN, sympy.exp: kp.EXP,
           sympy.log: kp.LOG, sympy.asin: kp.ASIN, sympy.acos: kp.ACOS, sympy.atan: kp.ATAN,

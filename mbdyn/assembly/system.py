@@ -12,15 +12,15 @@ import networkx as nx
 import numpy as np
 import sympy
 
-from .compile import Model
-from .elements.effects import parse_effects, warn_if_unphysical
-from .elements.values import has_symbols, numeric
-from .elements.bodies import inertia_tensor, make_body
-from .elements.joints import make_joint
-from .elements.loads import make_load
-from .errors import ModelError, ModelWarning, SingularMassMatrixError
-from .names import identifier_problem, label_problem
-from .elements.forces import GLOBAL_EFFECTS, make_force
+from ..compiled.model import Model
+from ..elements.effects import parse_effects, warn_if_unphysical
+from ..elements.values import has_symbols, numeric
+from ..elements.bodies import inertia_tensor, make_body
+from ..elements.joints import make_joint
+from ..elements.loads import make_load
+from ..errors import ModelError, ModelWarning, SingularMassMatrixError
+from ..names import identifier_problem, label_problem
+from ..elements.forces import GLOBAL_EFFECTS, make_force
 
 GROUND = "ground"
 

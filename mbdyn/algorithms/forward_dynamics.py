@@ -1,0 +1,88 @@
+"""Forward dynamics, ``u'`` from ``(q, u, t)``, by each route: ``M u' = f`` (Jourdain), the
+articulated-body algorithm, the Newton-Euler system with reactions eliminated in tree
+order or assembled dense; the choice ``"auto"`` makes; and the state derivative
+``[q', u']`` in one compiled call.
+"""
+from __future__ import annotations
+
+
+import numpy as np
+
+from ..errors import ModelError
+from ..kernels import packed as kp
+
+
+#: formulations of the forward dynamics: ``M(q) u' = f`` (Jourdain, composite-rigid-body
+#: mass matrix and Cholesky), the articulated-body algorithm (O(n)), the Newton-Euler
+#: system with reaction unknowns eliminated in tree order (O(n)) and the same system as the
+#: textbook writes it, assembled dense and solved by LU
+METHODS = ("jourdain", "articulated", "newton-euler", "newton-euler-dense")
+
+
+#: "auto" takes the articulated-body route from this many free speeds on (below it the
+#: mass matrix and its Cholesky factor are as cheap or cheaper: at 4 speeds the two cost
+#: the same, at 6 the articulated bodies 7-11 % less; docs/performance.md)
+ARTICULATED_FROM = 6
+
+
+def forward_dynamics(model, q, u, t=0.0, method="jourdain"):
+    """Speed rates ``u'``: from ``M(q) u' = f(q, u, t)`` (``method="jourdain"``), by the
+    articulated-body algorithm (``"articulated"``), or from the Newton-Euler system with
+    reactions, eliminated in tree order (``"newton-euler"``) or assembled dense and
+    solved by LU (``"newton-euler-dense"``).  All four solve the same equations;
+    ``docs/performance.md`` says which is fastest at which size."""
+    if method in ("jourdain", "articulated"):
+        q, u = model._state(q, u)
+        if model._python_inputs:
+            model._fill_inputs(q, u, t)
+        kernel = (kp.jourdain_accelerations_packed if method == "jourdain"
+                  else kp.articulated_accelerations_packed)
+        pivot = kernel(*model._packed, q, u)
+        if pivot >= 0:
+            model._raise_singular(q, t, pivot)
+        if pivot == -2:
+            model._check_finite(q, u, t, model._ud, "the accelerations")
+        return model._ud.copy()
+    if method in ("newton-euler", "newton-euler-dense"):
+        return model._newton_euler(q, u, t, dense=method == "newton-euler-dense")[:model.nu]
+    raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")
+
+
+def formulation(model, method="auto"):
+    """The per-call route ``method`` stands for: ``"auto"`` is ``"jourdain"`` for fewer
+    than ``ARTICULATED_FROM`` free speeds, else ``"articulated"`` (measured crossover,
+    docs/performance.md); any other name is checked and returned."""
+    if method == "auto":
+        return "jourdain" if model.nu < ARTICULATED_FROM else "articulated"
+    if method not in METHODS:
+        raise ModelError(f"unknown method {method!r}; use 'auto' or one of "
+                         f"{', '.join(METHODS)}")
+    return method
+
+
+def state_derivative(model, t, y, method="jourdain"):
+    """``[q', u']`` for the state ``y = [q, u]`` in one compiled call: ``q' = N(q) u``
+    (``coordinate_rates``) and ``u'`` as ``forward_dynamics`` gives it (``method``:
+    ``"jourdain"`` or ``"articulated"``).  Returns a new array."""
+    y = np.asarray(y, dtype=float)
+    if y.shape != (model.nq + model.nu,):
+        raise ModelError(f"model {model.name!r} expects a state of length "
+                         f"{model.nq + model.nu} (q then u), got shape {y.shape}")
+    if method == "jourdain":
+        kernel = kp.state_derivative_packed
+    elif method == "articulated":
+        kernel = kp.state_derivative_articulated_packed
+    else:
+        raise ModelError(f"state_derivative: unknown method {method!r}; use 'jourdain' "
+                         "or 'articulated'")
+    if model._python_inputs:
+        model._fill_inputs(y[:model.nq], y[model.nq:], t)
+    ydot = np.empty(model.nq + model.nu)
+    status = kernel(*model._packed, y, ydot)
+    if status >= 0:
+        model._raise_singular(y[:model.nq], t, status)
+    if status == -2:
+        rates = [c + "'" for c in model.coordinates] + [s + "'" for s in model.speeds]
+        model._check_finite(y[:model.nq], y[model.nq:], t, ydot, "the state derivative",
+                           rates)
+    return ydot

@@ -1,0 +1,75 @@
+"""The Newton-Euler-Jourdain form ``M(q) u' = f(q, u, t)``: the mass matrix (composite
+rigid bodies) and the forcing, by the kernels a run compiles anyway or by one packed call,
+and the check at compile that the system at rest is solvable.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import NonFiniteError
+from ..kernels import dynamics as kd
+from ..kernels import packed as kp
+
+
+def jourdain_terms(model, q, u, t):
+    q, u = model._kinematics_kernel(q, u, t)
+    model._drop_velocity_products()
+    kd.jourdain_terms(model._mass, model._com, model._inertia, model._has_inertia, model._R,
+                      model._r, model._w, model._alpha, model._a, model._JR, model._JT,
+                      model._anc_ptr, model._anc_idx, model._parent, model._F, model._N,
+                      model._M, model._f, model._scratch)
+    return q, u
+
+
+def mass_matrix(model, q, t=0.0):
+    """The Jourdain mass matrix ``M(q)`` (nu x nu, symmetric)."""
+    return model._mass_matrix(q, t, model._jourdain_packed)
+
+
+def mass_matrix_by(model, q, t, terms):
+    """``mass_matrix`` with the Jourdain terms computed by ``terms``: the packed,
+    one-call route (``_jourdain_packed``) or the kernels a run compiles anyway
+    (``_jourdain_terms``; for the checks of a run, whose first start must not compile
+    the packed entry point).  The same kernels either way: the same numbers."""
+    terms(q, np.zeros(model.nu), t)
+    # the sum is finite exactly when every entry is (short of overflow, which the
+    # exact test below then clears): a third of the cost of isfinite().all()
+    if not math.isfinite(model._M.sum()) and not np.all(np.isfinite(model._M)):
+        model._require_finite(q, np.zeros(model.nu), t)
+        raise NonFiniteError(f"model {model.name!r}, t={t:.6g}: the mass matrix came out "
+                             "non-finite (check masses, inertias and drives)")
+    return model._M.copy()
+
+
+def forcing(model, q, u, t=0.0):
+    """The right-hand side ``f(q, u, t)`` of ``M u' = f``: applied, gyroscopic and
+    velocity-product terms projected by the Jacobians."""
+    model._jourdain_packed(q, u, t)
+    return model._f.copy()
+
+
+def jourdain_packed(model, q, u, t):
+    """``M`` and ``f`` into the workspace by one compiled call on the packed buffers
+    (``kernels.packed.jourdain_accelerations_packed``, which solves for ``u'`` too: a
+    small part of its cost, and no extra compiled entry point)."""
+    q, u = model._state(q, u)
+    if model._python_inputs:
+        model._fill_inputs(q, u, t)
+    kp.jourdain_accelerations_packed(*model._packed, q, u)
+    return q, u
+
+
+def check_at_rest(model, q, t=0.0):
+    """Raise what ``forward_dynamics(q, 0, t)`` raises -- ``SingularMassMatrixError``
+    or ``NonFiniteError`` -- by the same Cholesky solve of ``M u' = f``, called on the
+    terms ``mass_matrix`` computes; returns nothing.  Used when a system is compiled:
+    this way the check needs no compiled entry point of its own (a first run compiles
+    less)."""
+    q, u = model._state(q, np.zeros(model.nu))
+    model._jourdain_terms(q, u, t)
+    pivot = kd.cholesky_solve(model._M, model._f, model._L, model._ud)
+    if pivot >= 0:
+        model._raise_singular(q, t, pivot)
+    model._check_finite(q, u, t, model._ud, "the accelerations")

@@ -1,0 +1,114 @@
+"""Reactions and inverse dynamics: the force and moment each joint's parent exerts on its
+child (at the joint origin, world or child components), the efforts that make a given
+motion, and the drive efforts of driven joints.
+"""
+from __future__ import annotations
+
+
+import numpy as np
+
+from ..errors import ModelError
+from ..kernels import dynamics as kd
+from .forward_dynamics import ARTICULATED_FROM, METHODS
+
+
+def reactions(model, q, u, t=0.0, method="auto", frame="world"):
+    """Force and moment each joint's parent exerts on its child, reduced to the joint
+    origin (the child frame's origin): ``{joint: (F[3], M[3])}``, in world components
+    (``frame="world"``) or in the child frame's own components (``frame="child"``, as
+    the textbook writes reactions).
+
+    ``method="newton-euler"`` solves the system with reaction unknowns in tree order
+    (``"newton-euler-dense"``: the dense 6n system); ``"jourdain"`` and
+    ``"articulated"`` compute the accelerations by that route and then the joint
+    wrenches by inverse dynamics from the leaves to the root.  ``"auto"``: the dense
+    system below ``ARTICULATED_FROM`` speeds (it needs no compiled kernel beyond those
+    a run has, so a first run compiles less), tree order from there on.
+    """
+    if frame not in ("world", "child"):
+        raise ModelError(f"unknown frame {frame!r} for reactions; use 'world' or 'child'")
+    if method == "auto":
+        method = "newton-euler-dense" if model.nu < ARTICULATED_FROM else "newton-euler"
+    if method in ("newton-euler", "newton-euler-dense"):
+        out = model.newton_euler(q, u, t, dense=method == "newton-euler-dense")[1]
+    elif method in ("jourdain", "articulated"):
+        ud = model.forward_dynamics(q, u, t, method=method)
+        model._kinematics_kernel(q, u, t, ud)
+        model._drop_velocity_products()
+        w = np.empty((model.n_frames, 6))
+        kd.joint_wrenches(model._mass, model._com, model._inertia, model._parent, model._R,
+                          model._r, model._w, model._alpha, model._a, model._F, model._N, w)
+        out = {name: (w[i, :3].copy(), w[i, 3:].copy()) for i, name in enumerate(model.joints)}
+    else:
+        raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")
+    if frame == "child":
+        out = {name: (model._R[i].T @ f, model._R[i].T @ m)
+               for i, (name, (f, m)) in enumerate(out.items())}
+    return out
+
+
+def inverse_dynamics(model, q, u, u_dot, t=0.0, frame="world"):
+    """The efforts and reactions that make the motion ``(q, u, u')``: returns
+    ``(efforts, reactions)`` -- ``efforts`` ``{speed name: generalized force}`` the
+    actuators must add on each free speed, ``Q = M u' - f`` (a torque on a revolute
+    joint's speed, a force on a prismatic one), and ``reactions`` ``{joint: (F, M)}``
+    as ``Model.reactions`` gives them, the joints transmitting those efforts too."""
+    q, u = model._state(q, u)
+    ud = np.asarray(u_dot, dtype=float)
+    if ud.shape != (model.nu,):
+        raise ModelError(f"model {model.name!r}: u_dot needs {model.nu} values, got "
+                         f"{ud.size}")
+    M = model.mass_matrix(q, t)
+    f = model.forcing(q, u, t)
+    Q = M @ ud - f
+    model._kinematics_kernel(q, u, t, ud)
+    model._drop_velocity_products()
+    w = np.empty((model.n_frames, 6))
+    kd.joint_wrenches(model._mass, model._com, model._inertia, model._parent, model._R,
+                      model._r, model._w, model._alpha, model._a, model._F, model._N, w)
+    reactions = {name: (w[i, :3].copy(), w[i, 3:].copy())
+                 for i, name in enumerate(model.joints)}
+    if frame == "child":
+        reactions = {name: (model._R[i].T @ fo, model._R[i].T @ mo)
+                     for i, (name, (fo, mo)) in enumerate(reactions.items())}
+    elif frame != "world":
+        raise ModelError(f"unknown frame {frame!r} for reactions; use 'world' or 'child'")
+    return dict(zip(model.speeds, Q.tolist())), reactions
+
+
+def inverse_dynamics_along(model, t, q, u, u_dot=None, frame="world"):
+    """``inverse_dynamics`` along a trajectory: ``t`` (n,), ``q`` (n, nq), ``u``
+    (n, nu) and ``u_dot`` (n, nu; default the time derivative of ``u`` by second-order
+    finite differences, ``numpy.gradient``).  Returns ``(efforts (n, nu), {joint:
+    (n, 6)})`` -- force then moment, as ``reactions``."""
+    t = np.asarray(t, dtype=float)
+    q = np.asarray(q, dtype=float).reshape(len(t), model.nq)
+    u = np.asarray(u, dtype=float).reshape(len(t), model.nu)
+    if u_dot is None:
+        if len(t) < 3:
+            raise ModelError("inverse_dynamics_along: give u_dot, or at least three "
+                             "samples to differentiate u")
+        u_dot = np.gradient(u, t, axis=0, edge_order=2)
+    u_dot = np.asarray(u_dot, dtype=float).reshape(len(t), model.nu)
+    efforts = np.empty((len(t), model.nu))
+    reactions = {j: np.empty((len(t), 6)) for j in model.joints}
+    for k in range(len(t)):
+        e, r = model.inverse_dynamics(q[k], u[k], u_dot[k], t[k], frame)
+        efforts[k] = list(e.values())
+        for j, (fo, mo) in r.items():
+            reactions[j][k, :3], reactions[j][k, 3:] = fo, mo
+    return efforts, reactions
+
+
+def drive_efforts(model, q, u, t=0.0):
+    """Force or torque each driven joint needs to impose its motion: ``{joint: value}``
+    (the reaction component along the joint axis, in the axis' sense)."""
+    reac = model.reactions(q, u, t)
+    out = {}
+    for name, *_ in model._driven:
+        j = model._joint[name]
+        i = model._frame_index[j.child]
+        axis_world = model._R[i] @ j.axis
+        f, m = reac[name]
+        out[name] = float(axis_world @ (m if j.kind == "revolute" else f))
+    return out

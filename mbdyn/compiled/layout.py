@@ -1,0 +1,244 @@
+"""The compiled model's data: the element records laid out as flat arrays in topological
+order, and the workspace every evaluation writes into.
+
+Each function lays out one part and sets it on the ``Model`` (its private ``_``
+attributes, which the algorithms and kernels read): the tree, the coordinates, the bodies,
+the reaction directions, the loads, the workspace.  ``Model.__init__`` calls them in this
+order; ``pack`` then moves the arrays the fused kernels read into two flat buffers.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..kernels import evaluate as ke
+from ..kernels import packed as kp
+
+
+def tree(model, joints):
+    """Each frame's joint: parent index, kind code, axis, Euler sequence, placement
+    (position and orientation ``C`` in the parent)."""
+    n = len(joints)
+    model._parent = np.array([model._frame_index.get(j.parent, -1) for j in joints], np.int64)
+    model._kind = np.array([j.code for j in joints], np.int64)
+    model._axis = np.array([j.axis for j in joints], float).reshape(n, 3)
+    model._seq = np.array([j.sequence for j in joints], np.int64).reshape(n, 3)
+    model._pos = np.array([j.position for j in joints], float).reshape(n, 3)
+    model._C = np.array([j.orientation for j in joints], float).reshape(n, 3, 3)
+
+
+def coordinates(model, joints):
+    """Where each joint's coordinates and speeds sit: offsets into the joint-space vectors
+    (every joint) and columns of the free ``u`` (free joints only); the free coordinates'
+    and speeds' names and indices; the driven joints, quaternion slices, the free joints'
+    slots for ``q' = N(q) u`` and the Euler joints' middle angles."""
+    n = len(joints)
+    qoff = np.zeros(n, np.int64)
+    uoff = np.zeros(n, np.int64)
+    ucol = -np.ones(n, np.int64)
+    free_q, free_u, coords, speeds = [], [], [], []
+    model._driven = []                 # (joint, qfull index, ufull index, drive)
+    model._quaternions = []            # slices of q holding a quaternion
+    nqf = nuf = 0
+    for i, j in enumerate(joints):
+        qoff[i], uoff[i] = nqf, nuf
+        if j.drive is not None:
+            model._driven.append((j.name, nqf, nuf, j.drive))
+        elif j.nu:
+            ucol[i] = len(free_u)
+            start = len(free_q)
+            if j.kind == "spherical":
+                model._quaternions.append(slice(start, start + 4))
+            elif j.kind == "free":
+                model._quaternions.append(slice(start + 3, start + 7))
+            free_q.extend(range(nqf, nqf + j.nq))
+            free_u.extend(range(nuf, nuf + j.nu))
+            coords.extend(j.coordinates)
+            speeds.extend(j.speeds)
+        nqf += j.nq
+        nuf += j.nu
+    model._nq_full, model._nu_full = nqf, nuf
+    model._qoff, model._uoff, model._ucol = qoff, uoff, ucol
+    model._free_q = np.array(free_q, np.int64)
+    model._free_u = np.array(free_u, np.int64)
+    model.coordinates = tuple(coords)
+    model.speeds = tuple(speeds)
+    model.nq, model.nu = len(coords), len(speeds)
+    model._coordinate_index = {c: k for k, c in enumerate(coords)}
+    model._speed_index = {c: k for k, c in enumerate(speeds)}
+    model._speed_joint = []            # joint name of each speed
+    model._free_joint_slots = []       # (kind code, q start, nq, u start, nu)
+    model._euler_middle = []           # (joint, q index of middle angle, proper sequence?)
+    qi = ui = 0
+    for j in joints:
+        if j.drive is None and j.nu:
+            model._free_joint_slots.append((j.code, qi, j.nq, ui, j.nu))
+            if j.kind == "euler":
+                model._euler_middle.append((j.name, qi + 1, j.sequence[0] == j.sequence[2]))
+            model._speed_joint.extend([j.name] * j.nu)
+            qi += j.nq
+            ui += j.nu
+
+
+def columns(model, joints):
+    """The columns of ``u`` each frame's motion depends on: its own joint's and its
+    ancestors' (the Jacobians' sparsity), and its own joint's only (all the articulated
+    body route reads), as compressed rows ``(ptr, idx)``."""
+    ucol, parent = model._ucol, model._parent
+    own = [list(range(ucol[i], ucol[i] + j.nu)) if ucol[i] >= 0 else []
+           for i, j in enumerate(joints)]
+    cols = []
+    for i in range(len(joints)):
+        inherited = cols[parent[i]] if parent[i] >= 0 else []
+        cols.append(sorted(inherited + own[i]))
+    model._anc_ptr = np.cumsum([0] + [len(c) for c in cols]).astype(np.int64)
+    model._anc_idx = np.array([c for cs in cols for c in cs], np.int64)
+    model._own_ptr = np.cumsum([0] + [len(c) for c in own]).astype(np.int64)
+    model._own_idx = np.array([c for cs in own for c in cs], np.int64)
+
+
+def bodies(model, records):
+    """Mass, centre of mass (body components) and inertia about it (body axes) per frame."""
+    n = len(records)
+    model._mass = np.array([b.mass for b in records], float)
+    model._com = np.array([b.com for b in records], float).reshape(n, 3)
+    model._inertia = np.array([b.inertia for b in records], float).reshape(n, 3, 3)
+    model._has_inertia = np.array([b.has_inertia for b in records], np.bool_)
+
+
+def _perpendicular_pair(a):
+    """Two unit vectors completing ``a`` to a right-handed orthonormal basis."""
+    helper = np.eye(3)[np.argmin(np.abs(a))]
+    n1 = np.cross(a, helper)
+    n1 /= np.linalg.norm(n1)
+    return n1, np.cross(a, n1)
+
+
+def reaction_basis(joint):
+    """Directions (child-frame components) of the reaction components a joint transmits:
+    ``[(force, moment), ...]`` -- six minus its degrees of freedom, plus the drive's."""
+    e = np.eye(3)
+    z = np.zeros(3)
+    kind = joint.kind
+    forces = [(e[k], z) for k in range(3)]
+    moments = [(z, e[k]) for k in range(3)]
+    if kind == "fixed":
+        basis = forces + moments
+    elif kind in ("spherical", "euler"):
+        basis = forces
+    elif kind == "free":
+        basis = []
+    elif kind == "revolute":
+        n1, n2 = _perpendicular_pair(joint.axis)
+        basis = forces + [(z, n1), (z, n2)]
+        if joint.drive is not None:
+            basis.append((z, joint.axis.copy()))
+    else:  # prismatic
+        n1, n2 = _perpendicular_pair(joint.axis)
+        basis = [(n1, z), (n2, z)] + moments
+        if joint.drive is not None:
+            basis.append((joint.axis.copy(), z))
+    return basis
+
+
+def reactions(model, joints):
+    """The reaction unknowns of the Newton-Euler system: for each component its joint and
+    its force and moment directions (child components); each joint's slice of them."""
+    rj, rf, rm, model._reaction_slices = [], [], [], {}
+    for i, j in enumerate(joints):
+        basis = reaction_basis(j)
+        model._reaction_slices[j.name] = slice(len(rj), len(rj) + len(basis))
+        for fo, mo in basis:
+            rj.append(i)
+            rf.append(fo)
+            rm.append(mo)
+    model._react_joint = np.array(rj, np.int64)
+    model._react_force = np.array(rf, float).reshape(-1, 3)
+    model._react_moment = np.array(rm, float).reshape(-1, 3)
+
+
+def loads(model, records):
+    """Point loads: body index, point, components (world or body), and the constant
+    values; returns the loads given as functions, ``[(load, array name, row, callable)]``
+    (sympy expressions are turned into functions here)."""
+    model.loads = tuple(ld.name for ld in records)
+    nl = len(records)
+    model._load_body = np.array([model._frame_index[ld.body] for ld in records], np.int64)
+    model._load_point = np.array([ld.point for ld in records], float).reshape(nl, 3)
+    model._load_in_body = np.array([ld.in_body for ld in records], np.bool_)
+    model._load_force = np.zeros((nl, 3))
+    model._load_moment = np.zeros((nl, 3))
+    functions = []
+    for k, ld in enumerate(records):
+        for target, val in (("_load_force", ld.force), ("_load_moment", ld.moment)):
+            if isinstance(val, tuple):
+                val = model._lambdify_load(ld.name, val)
+            if callable(val):
+                functions.append((ld.name, target, k, val))
+            else:
+                getattr(model, target)[k] = val
+    return functions
+
+
+def workspace(model, joints):
+    """The arrays every evaluation writes into: joint-space state, frame motion, Jacobians,
+    applied loads, ``M``, ``f`` and their factor, the dense Newton-Euler system, the
+    articulated inertias, the reaction unknowns, and one scratch array for the kernels'
+    temporaries (``kernels.evaluate.scratch_size``)."""
+    n, nu = model.n_frames, model.nu
+    model._qfull = np.zeros(model._nq_full)
+    model._ufull = np.zeros(model._nu_full)
+    model._udfull = np.zeros(model._nu_full)
+    for i, j in enumerate(joints):    # identity quaternions where nothing else is set
+        if j.kind == "spherical":
+            model._qfull[model._qoff[i]] = 1.0
+        elif j.kind == "free":
+            model._qfull[model._qoff[i] + 3] = 1.0
+    model._R = np.zeros((n, 3, 3))
+    model._r, model._w, model._v = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))
+    model._alpha, model._a = np.zeros((n, 3)), np.zeros((n, 3))
+    model._JR = np.zeros((n, 3, nu))
+    model._JT = np.zeros((n, 3, nu))
+    model._F, model._N = np.zeros((n, 3)), np.zeros((n, 3))
+    model._M = np.zeros((nu, nu))
+    model._f = np.zeros(nu)
+    model._L = np.zeros((nu, nu))
+    model._A = np.zeros((6 * n, 6 * n))
+    model._b = np.zeros(6 * n)
+    model._ud = np.zeros(nu)
+    # articulated bodies (kernels.articulated): per frame 6x6 inertias, biases, the
+    # joint's U = IA S and Cholesky factor of D, accelerations, joint wrenches
+    model._IA, model._U = np.zeros((n, 6, 6)), np.zeros((n, 6, 6))
+    model._pA, model._cb, model._acc = np.zeros((n, 6)), np.zeros((n, 6)), np.zeros((n, 6))
+    model._Dl, model._W = np.zeros((n, 6, 7)), np.zeros((n, 6))
+    model._lam = np.zeros(len(model._react_joint))
+    model._scratch = np.zeros(ke.scratch_size(n, nu, model._nu_full))
+    model._slots = np.array(model._free_joint_slots, np.int64).reshape(-1, 5)
+
+
+def pack(model):
+    """Move every array the fused kernels use into two flat buffers (``kernels.packed``):
+    the attributes become views of them, and a kernel call passes three arrays instead of
+    38."""
+    attr = {name: "gravity" if name == "gravity" else "_" + name
+            for name in kp.FLOATS + kp.INTS}
+    fbuf, ibuf, table, views = kp.pack(
+        {k: getattr(model, attr[k]) for k in kp.FLOATS},
+        {k: getattr(model, attr[k]) for k in kp.INTS})
+    for name, view in views.items():
+        setattr(model, attr[name], view)
+    model._packed = (fbuf, ibuf, table)
+
+
+def argument_groups(model):
+    """The groups of arrays the kernels take together: the tree, the loads (``None``
+    for the force table of a model without force elements, so that the compiled kernels
+    are specialised without them: ``kernels/evaluate.kinematics_and_loads``), and the
+    kinematics' outputs."""
+    model._tree = (model._parent, model._kind, model._axis, model._seq, model._pos, model._C,
+                   model._qoff, model._uoff, model._ucol, model._anc_ptr, model._anc_idx)
+    model._loads_arrays = (model._load_body, model._load_point, model._load_force,
+                           model._load_moment, model._load_in_body,
+                           model._force_int if model._force_int.shape[0] else None,
+                           model._force_data, model._switches)
+    model._kin_out = (model._R, model._r, model._w, model._v, model._alpha, model._a,
+                      model._JR, model._JT, model._F, model._N)

@@ -1,0 +1,224 @@
+"""The compiled, frozen ``Model``: the model's data (``compiled.layout``) and its numeric
+API, whose methods are the algorithms of ``mbdyn.algorithms`` (one job a module).
+
+``System.compile()`` (``mbdyn.assembly``) validates the tree and hands its elements here
+in topological order; this layer knows nothing of the tree, only of the element records.
+A changed parameter means a new compile, which is cheap (the kernels are compiled once per
+machine and cached by numba).
+
+State conventions: ``q`` (coordinates) and ``u`` (speeds) are the *free* ones, in the order
+``Model.coordinates`` / ``Model.speeds``; driven joints have no entry, their motion comes
+from their drives.  Vectors are in inertial (world) components unless stated.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..algorithms import diagnosis, inputs, jourdain
+from ..algorithms import energy as energies
+from ..algorithms import forward_dynamics as forward
+from ..algorithms import kinematics as motion
+from ..algorithms import newton_euler as ne
+from ..algorithms import reactions as joint_reactions
+from ..errors import ModelError
+from . import layout, states
+from .force_packing import pack_forces
+
+
+class Model:
+    """A compiled multibody model (frozen).  Build it with ``System.compile()``.
+
+    Not thread-safe: evaluations share one preallocated workspace; every method returns
+    fresh arrays.
+    """
+
+    def __init__(self, name, bodies, joints, loads, gravity, warnings=(), parameters=None,
+                 gravity_symbolic=None, forces=(), effects=None):
+        self.name = name
+        self.warnings = tuple(warnings)
+        self.gravity = np.array(gravity, dtype=float)
+        #: the element records in topological order (for the symbolic layer and reports)
+        self.elements = (tuple(bodies), tuple(joints), tuple(loads))
+        self.parameters = dict(parameters or {})
+        self.gravity_symbolic = gravity_symbolic
+        self.frames = tuple(b.name for b in bodies)
+        self.bodies = tuple(b.name for b in bodies if b.has_inertia)
+        self.joints = tuple(j.name for j in joints)
+        self._joint = {j.name: j for j in joints}
+        self._body = {b.name: b for b in bodies}
+        self._frame_index = {nm: i for i, nm in enumerate(self.frames)}
+        self.n_frames = len(bodies)
+        layout.tree(self, joints)
+        layout.coordinates(self, joints)
+        layout.columns(self, joints)
+        layout.bodies(self, bodies)
+        layout.reactions(self, joints)
+        load_functions = layout.loads(self, loads)
+        # -- force elements and the effects the scene chose (only what is on is here)
+        self._force_elements = tuple(forces)
+        self.forces = tuple(el.name for el in forces)
+        #: ``{effect: on}`` as the scene chose them (see ``mbdyn.elements.effects``)
+        self.effects = dict(effects) if effects is not None else dict.fromkeys(
+            ("gravity", "gyroscopic") + self.loads + self.forces, True)
+        self.gyroscopic = bool(self.effects.get("gyroscopic", True))
+        self._force_int, self._force_data, laws = pack_forces(self, forces)
+        self._switches = np.array([1 if self.gyroscopic else 0], np.int64)
+        layout.workspace(self, joints)
+        layout.pack(self)
+        #: (load name, the row of the load array its function fills, the function)
+        self._load_functions = [(name, getattr(self, target)[k], fn)
+                                for name, target, k, fn in load_functions]
+        #: force laws evaluated in Python: (element, its force slot in the packed data, law)
+        self._laws = laws
+        #: drives, function loads or force laws: values Python writes before each compiled
+        #: evaluation
+        self._python_inputs = bool(self._driven or self._load_functions or self._laws)
+        layout.argument_groups(self)
+
+    def __repr__(self):
+        return (f"<Model {self.name!r}: {self.n_frames} frames, {len(self.joints)} joints, "
+                f"nq={self.nq}, nu={self.nu}>")
+
+    # ------------------------------------------------------------------ names and records
+    def joint(self, name):
+        """The joint record (kind, axis, parent, child, coordinates, drive...)."""
+        return self._joint[name]
+
+    def body(self, name):
+        """The body record (mass, com, inertia about the centre of mass)."""
+        return self._body[name]
+
+    def coordinate_index(self, name):
+        return self._coordinate_index[name]
+
+    def speed_index(self, name):
+        return self._speed_index[name]
+
+    def frame_index(self, name):
+        try:
+            return self._frame_index[name]
+        except KeyError:
+            raise ModelError(f"unknown frame {name!r}; the model's frames are "
+                             f"{', '.join(self.frames)}") from None
+
+    @property
+    def driven_joints(self):
+        return tuple(d[0] for d in self._driven)
+
+    def force_element(self, name):
+        """The force-element record (kind, frames, parameters) by name."""
+        for el in self._force_elements:
+            if el.name == name:
+                return el
+        raise ModelError(f"unknown force element {name!r}; the model's force elements are "
+                         f"{', '.join(self.forces) or '(none)'}")
+
+    def describe_speeds(self, speeds):
+        """``"theta2 (joint 'theta2')"``: the coordinates and joints behind some speeds
+        (for a joint whose speeds are not coordinate rates, the speeds are named too)."""
+        parts = []
+        for j in dict.fromkeys(self._speed_joint[self._speed_index[s]] for s in speeds):
+            joint = self._joint[j]
+            mine = [x for x in speeds if self._speed_joint[self._speed_index[x]] == j]
+            if joint.kind in ("spherical", "free"):
+                parts.append(f"{', '.join(mine)} (joint {j!r})")
+            else:
+                coords = [joint.coordinates[joint.speeds.index(x)] for x in mine]
+                parts.append(f"{', '.join(coords)} (joint {j!r})")
+        return "; ".join(parts) or "some coordinates"
+
+    # ------------------------------------------------------------------ states by name
+    default_coordinates = states.default_coordinates
+    q_vector = states.q_vector
+    u_vector = states.u_vector
+    _vector = states.vector
+    _vector_of = states.vector_of
+    normalize_quaternions = states.normalize_quaternions
+    quaternion_drift = states.quaternion_drift
+
+    # ------------------------------------------------------------------ evaluation core
+    _fill = inputs.fill
+    _as_arrays = inputs.as_arrays
+    _require_finite = inputs.require_finite
+    _state = inputs.state
+    _fill_inputs = inputs.fill_inputs
+    _fill_laws = inputs.fill_laws
+    _check_finite = inputs.check_finite
+    _lambdify_load = inputs.lambdify_load
+    _kinematics_kernel = motion.kinematics_kernel
+    _drop_velocity_products = motion.drop_velocity_products
+    _jourdain_terms = jourdain.jourdain_terms
+    _jourdain_packed = jourdain.jourdain_packed
+    _mass_matrix = jourdain.mass_matrix_by
+    _check_at_rest = jourdain.check_at_rest
+    _newton_euler = ne.solve
+    _reactions_from = ne.reactions_from
+    _raise_singular = diagnosis.raise_singular
+
+    # ------------------------------------------------------------------ the numeric API
+    kinematics = motion.kinematics
+    jacobian_rotation = motion.jacobian_rotation
+    jacobian_translation = motion.jacobian_translation
+    point_positions = motion.point_positions
+    coordinate_rates = motion.coordinate_rates
+    mass_matrix = jourdain.mass_matrix
+    forcing = jourdain.forcing
+    forward_dynamics = forward.forward_dynamics
+    formulation = forward.formulation
+    state_derivative = forward.state_derivative
+    newton_euler = ne.newton_euler
+    reactions = joint_reactions.reactions
+    inverse_dynamics = joint_reactions.inverse_dynamics
+    inverse_dynamics_along = joint_reactions.inverse_dynamics_along
+    drive_efforts = joint_reactions.drive_efforts
+    energy = energies.energy
+    momentum = energies.momentum
+    element_energy = energies.element_energy
+    load_power = energies.load_power
+    euler_singularity = diagnosis.euler_singularity
+    mass_matrix_condition = diagnosis.mass_matrix_condition
+
+    def lowlevel(self, method="auto"):
+        """The low-level entry (``mbdyn.compiled.lowlevel.LowLevel``):
+        ``forward_dynamics(q, u)`` and ``state_derivative(y)`` as single compiled calls on
+        preallocated buffers, for loops of your own; ``method``: ``"auto"``,
+        ``"jourdain"`` or ``"articulated"``."""
+        from .lowlevel import LowLevel
+        return LowLevel(self, self.formulation(method))
+
+    # ------------------------------------------------------------------ compiled loops
+    @property
+    def has_callable_loads(self):
+        """True when some load is a Python function (compiled loops cannot call it)."""
+        return bool(self._load_functions or self._laws)
+
+    def drive_values(self, times):
+        """``(len(times), n_drives, 3)``: each drive's ``q, q', q''`` at ``times``."""
+        out = np.empty((len(times), len(self._driven), 3))
+        for d, (_, _, _, drive) in enumerate(self._driven):
+            for k, tk in enumerate(times):
+                out[k, d] = drive.position(tk), drive.velocity(tk), drive.acceleration(tk)
+        return out
+
+    def loop_arguments(self, method="jourdain"):
+        """The arrays ``kernels.integrators.fixed_step_loop`` needs after its drive table:
+        ``(nq, slots, quats, free_q, free_u, drive_q, drive_u, tree, body, loads, ws)``;
+        laid out for ``method`` ``"jourdain"`` or ``"articulated"`` (the compiled loops
+        choose their route by the workspace's layout, ``integrators.accelerations``)."""
+        slots = self._slots
+        quats = np.array([s.start for s in self._quaternions], np.int64)
+        drive_q = np.array([d[1] for d in self._driven], np.int64)
+        drive_u = np.array([d[2] for d in self._driven], np.int64)
+        body = (self._mass, self._com, self._inertia, self._has_inertia, self.gravity)
+        ws = (self._qfull, self._ufull, self._udfull, self._R, self._r, self._w, self._v,
+              self._alpha, self._a, self._JR, self._JT, self._F, self._N)
+        tree = self._tree
+        if method == "jourdain":
+            ws += (self._M, self._f, self._L, self._scratch)
+        elif method == "articulated":
+            ws += (self._IA, self._pA, self._cb, self._U, self._Dl, self._acc, self._scratch)
+            tree = tree[:9] + (self._own_ptr, self._own_idx)
+        else:
+            raise ModelError(f"loop_arguments: no compiled loop for method {method!r}")
+        return (self.nq, slots, quats, self._free_q, self._free_u, drive_q, drive_u,
+                tree, body, self._loads_arrays, ws)
