@@ -89,7 +89,7 @@ class System:
         """A rigid body: ``mass``, centre of mass ``com`` in body components (from the
         frame origin), ``inertia`` about the centre of mass in body axes -- ``None``/0 for a
         particle, three principal moments, or a 3x3 tensor (see ``mbdyn.inertia``).
-        ``shape``: how pictures draw it (``mbdyn.elements.make_shape``).
+        ``shape``: how pictures draw it (``mbdyn.elements.bodies.make_shape``).
         ``inertia_about="origin"``: the inertia is given about the frame origin instead (as
         the textbook's top data are); it is moved to the centre of mass by the parallel-axis
         theorem, ``I_G = I_O - m (|c|^2 E - c c^T)``."""

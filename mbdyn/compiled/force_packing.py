@@ -34,98 +34,130 @@ def speed_slot(model, name, element):
                      "or a driven joint's name")
 
 
+class _Data:
+    """The float array being written: each element's numbers and tables, appended."""
+
+    def __init__(self):
+        self.values = []
+
+    def put(self, values):
+        """Append ``values``; their offset."""
+        at = len(self.values)
+        self.values.extend(float(v) for v in np.asarray(values, float).reshape(-1))
+        return at
+
+    def put_table(self, table):
+        """Append a table's block; ``(offset, interpolation mode)``, ``(0, NO_TABLE)``
+        for none."""
+        if table is None:
+            return 0, kf.NO_TABLE
+        return self.put(table.block()), table.mode
+
+
 def pack_forces(model, forces):
     """``(force_int, force_data, laws)`` for the enabled force elements; ``laws`` lists
     ``(element, data index of its force slot, law)`` for the laws evaluated in Python."""
-    rows, data, laws = [], [], []
-
-    def put(values):
-        at = len(data)
-        data.extend(float(v) for v in np.asarray(values, float).reshape(-1))
-        return at
-
-    def put_table(table):
-        if table is None:
-            return 0, kf.NO_TABLE
-        return put(table.block()), table.mode
-
+    rows, data, laws = [], _Data(), []
     for el in forces:
-        element = f"force {el.name!r}"
-        p = el.params
         row = [0] * kf.ROW
-        if el.kind == "spring-damper":
-            ia, ib = (_frame(model, n, element) for n in el.frames)
-            if ia == ib:
-                raise ModelError(f"{element}: body_a and body_b are both {el.frames[0]!r}; a "
-                                 "spring acts between two bodies (or a body and the ground)")
-            off = put(np.concatenate([p["point_a"], p["point_b"],
-                                      [p["stiffness"], p["damping"], p["free_length"],
-                                       p["preload"], p["min_length"]]]))
-            row[:4] = [kf.SPRING_DAMPER, ia, ib, off]
-            row[4:6] = put_table(p["force_table"])
-            row[6:8] = put_table(p["damping_table"])
-            if p.get("law") is not None:
-                row[5] = kf.LAW
-                laws.append((el, off + 9, p["law"]))
-        elif el.kind == "joint-spring-damper":
-            name = p["joint"]
-            if name not in model._joint:
-                raise ModelError(f"{element}: unknown joint {name!r}; the model's joints are "
-                                 f"{', '.join(model.joints)}")
-            j = model._joint[name]
-            if j.kind not in ("revolute", "prismatic"):
-                raise ModelError(f"{element}: joint {name!r} is {j.kind}; a joint spring acts "
-                                 "on the coordinate of a revolute or prismatic joint (use a "
-                                 "bushing for other joints)")
-            i = model._frame_index[j.child]
-            off = put([p["rest"], p["stiffness"], p["damping"], p["preload"],
-                       1.0 if j.kind == "prismatic" else 0.0])
-            row[:4] = [kf.JOINT_SPRING_DAMPER, i, int(model._parent[i]), off]
-            row[4:6] = put_table(p["force_table"])
-            row[6:8] = put_table(p["damping_table"])
-            row[8:10] = [int(model._qoff[i]), int(model._uoff[i])]
-            if p.get("law") is not None:
-                row[5] = kf.LAW
-                laws.append((el, off + 3, p["law"]))
-        elif el.kind == "bushing":
-            ia, ib = (_frame(model, n, element) for n in el.frames)
-            if ia == ib:
-                raise ModelError(f"{element}: body_a and body_b are both {el.frames[0]!r}")
-            off = put(np.concatenate([p["point_a"], p["point_b"], p["stiffness"].ravel(),
-                                      p["damping"].ravel()]))
-            row[:4] = [kf.BUSHING, ia, ib, off]
-        elif el.kind == "bearing":
-            ia, ib = (_frame(model, n, element) for n in el.frames)
-            if ia == ib or ia < 0:
-                raise ModelError(f"{element}: the shaft body must be a body other than the "
-                                 "housing")
-            consts = [0.0 if isinstance(p[c], Table) else p[c] for c in BEARING_COEFFICIENTS]
-            off = put(np.concatenate([p["point"], p["center"], p["e1"], p["e2"], consts,
-                                      -np.ones(8)]))
-            mode = kf.NO_TABLE
-            for k, c in enumerate(BEARING_COEFFICIENTS):
-                if isinstance(p[c], Table):
-                    data[off + 20 + k] = float(put(p[c].block()))
-                    mode = p[c].mode
-            slot = -1 if p["speed"] is None else speed_slot(model, p["speed"], element)
-            row[:4] = [kf.BEARING, ia, ib, off]
-            row[5] = mode
-            row[8] = slot
-        else:   # contact
-            i = _frame(model, el.frames[0], element)
-            if i < 0:
-                raise ModelError(f"{element}: the ground cannot touch the ground; name a body")
-            values = np.concatenate([p["center"], [p["radius"]], p["plane_point"],
-                                     p["plane_normal"],
-                                     [p["stiffness"], p["exponent"], p["damping_factor"],
-                                      p["friction"], p["slip_speed"]], p["axis"]])
-            off = put(values)
-            kind = kf.CONTACT_DISK if p["shape"] == "disk" else kf.CONTACT_SPHERE
-            row[:4] = [kind, i, -1, off]
+        _PACKERS[el.kind](model, el, f"force {el.name!r}", row, data, laws)
         rows.append(row)
     force_int = np.array(rows, np.int64).reshape(len(rows), kf.ROW)
-    force_data = np.array(data, float)
+    force_data = np.array(data.values, float)
     return force_int, force_data, laws
+
+
+def _two_bodies(model, el, element):
+    ia, ib = (_frame(model, n, element) for n in el.frames)
+    if ia == ib:
+        raise ModelError(f"{element}: body_a and body_b are both {el.frames[0]!r}; a "
+                         "spring acts between two bodies (or a body and the ground)"
+                         if el.kind == "spring-damper" else
+                         f"{element}: body_a and body_b are both {el.frames[0]!r}")
+    return ia, ib
+
+
+def _spring_damper(model, el, element, row, data, laws):
+    p = el.params
+    ia, ib = _two_bodies(model, el, element)
+    off = data.put(np.concatenate([p["point_a"], p["point_b"],
+                                   [p["stiffness"], p["damping"], p["free_length"],
+                                    p["preload"], p["min_length"]]]))
+    row[:4] = [kf.SPRING_DAMPER, ia, ib, off]
+    row[4:6] = data.put_table(p["force_table"])
+    row[6:8] = data.put_table(p["damping_table"])
+    if p.get("law") is not None:
+        row[5] = kf.LAW
+        laws.append((el, off + 9, p["law"]))
+
+
+def _joint_spring_damper(model, el, element, row, data, laws):
+    p = el.params
+    name = p["joint"]
+    if name not in model._joint:
+        raise ModelError(f"{element}: unknown joint {name!r}; the model's joints are "
+                         f"{', '.join(model.joints)}")
+    j = model._joint[name]
+    if j.kind not in ("revolute", "prismatic"):
+        raise ModelError(f"{element}: joint {name!r} is {j.kind}; a joint spring acts "
+                         "on the coordinate of a revolute or prismatic joint (use a "
+                         "bushing for other joints)")
+    i = model._frame_index[j.child]
+    off = data.put([p["rest"], p["stiffness"], p["damping"], p["preload"],
+                    1.0 if j.kind == "prismatic" else 0.0])
+    row[:4] = [kf.JOINT_SPRING_DAMPER, i, int(model._parent[i]), off]
+    row[4:6] = data.put_table(p["force_table"])
+    row[6:8] = data.put_table(p["damping_table"])
+    row[8:10] = [int(model._qoff[i]), int(model._uoff[i])]
+    if p.get("law") is not None:
+        row[5] = kf.LAW
+        laws.append((el, off + 3, p["law"]))
+
+
+def _bushing(model, el, element, row, data, laws):
+    p = el.params
+    ia, ib = _two_bodies(model, el, element)
+    off = data.put(np.concatenate([p["point_a"], p["point_b"], p["stiffness"].ravel(),
+                                   p["damping"].ravel()]))
+    row[:4] = [kf.BUSHING, ia, ib, off]
+
+
+def _bearing(model, el, element, row, data, laws):
+    p = el.params
+    ia, ib = (_frame(model, n, element) for n in el.frames)
+    if ia == ib or ia < 0:
+        raise ModelError(f"{element}: the shaft body must be a body other than the "
+                         "housing")
+    consts = [0.0 if isinstance(p[c], Table) else p[c] for c in BEARING_COEFFICIENTS]
+    off = data.put(np.concatenate([p["point"], p["center"], p["e1"], p["e2"], consts,
+                                   -np.ones(8)]))
+    mode = kf.NO_TABLE
+    for k, c in enumerate(BEARING_COEFFICIENTS):
+        if isinstance(p[c], Table):
+            data.values[off + 20 + k] = float(data.put(p[c].block()))
+            mode = p[c].mode
+    slot = -1 if p["speed"] is None else speed_slot(model, p["speed"], element)
+    row[:4] = [kf.BEARING, ia, ib, off]
+    row[5] = mode
+    row[8] = slot
+
+
+def _contact(model, el, element, row, data, laws):
+    p = el.params
+    i = _frame(model, el.frames[0], element)
+    if i < 0:
+        raise ModelError(f"{element}: the ground cannot touch the ground; name a body")
+    off = data.put(np.concatenate([p["center"], [p["radius"]], p["plane_point"],
+                                   p["plane_normal"],
+                                   [p["stiffness"], p["exponent"], p["damping_factor"],
+                                    p["friction"], p["slip_speed"]], p["axis"]]))
+    kind = kf.CONTACT_DISK if p["shape"] == "disk" else kf.CONTACT_SPHERE
+    row[:4] = [kind, i, -1, off]
+
+
+#: each force-element kind's packer: its row of integers and its numbers in the data
+_PACKERS = {"spring-damper": _spring_damper, "joint-spring-damper": _joint_spring_damper,
+            "bushing": _bushing, "bearing": _bearing, "contact": _contact}
 
 
 def warn_outside_tables(model, t, u):

@@ -63,7 +63,7 @@ class EventRecord(tuple):
 class CompiledCondition:
     """``g(t, q, u)`` of a sympy condition ``g`` over ``args`` (``t``, then the model's
     coordinate and speed symbols): evaluated in compiled code by its program
-    (``mbdyn.programs.condition_program``), the same program the compiled loops run after
+    (``mbdyn.compiled.programs.condition_program``), the same program the compiled loops run after
     every step; by numpy when the stack machine cannot evaluate it (``program`` is
     ``None``)."""
 

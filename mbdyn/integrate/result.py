@@ -18,7 +18,7 @@ class Result:
     by name; ``events`` is ``[(name, t), ...]`` (``EventRecord``s: each also carries the
     state there, ``.q``, ``.u``, ``.state``); ``stats`` the integrator's statistics;
     on request ``reactions`` ``{joint: (n, 6)}`` (force then moment, world components, at
-    the joint origin), ``energy`` (see ``mbdyn.balance.energy_balance``: ``kinetic``,
+    the joint origin), ``energy`` (see ``mbdyn.integrate.balance.energy_balance``: ``kinetic``,
     ``potential``, ``total`` = T + V, ``dissipated``, ``work``, ``balance``) and ``points``
     ``{name: (n, 3)}``.  With energies, ``stats["energy_drift"]`` is
     ``max |B(t) - B(0)|`` of the balance ``B = T + V + dissipated - work`` over the energy

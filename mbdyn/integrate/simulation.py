@@ -53,7 +53,7 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     Euler-angle joint comes this close to its singularity (see ``Model.euler_singularity``).
     ``compiled_loop``: run fixed-step schemes, RK45 and DOP853 in compiled stretches when
     the model allows (``method`` ``"jourdain"`` or ``"articulated"``, no Python-function loads and, for RK45 and
-    DOP853, drives that ``mbdyn.programs`` translates); ``False`` forces the Python loop
+    DOP853, drives that ``mbdyn.compiled.programs`` translates); ``False`` forces the Python loop
     (scipy's solvers for RK45 and DOP853, which ``"scipy-RK45"`` and ``"scipy-DOP853"``
     also name).
     ``decimate``: fixed-step schemes store every ``decimate``-th step (and the last).

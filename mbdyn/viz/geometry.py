@@ -5,7 +5,7 @@ Every body with mass is drawn as a sphere at its centre of mass, sized by its ma
 (relative to the heaviest body), and every joint as a line from the parent frame's origin
 to the child frame's origin and on to the child's centre of mass -- so every model draws
 without edits.  Each frame's axes are drawn at its origin (x red, y green, z blue).
-Shapes (``mbdyn.elements.make_shape``) are drawn as wireframes: a box by its
+Shapes (``mbdyn.elements.bodies.make_shape``) are drawn as wireframes: a box by its
 edges, a cylinder or disk by its two rims and four lines, a sphere by three great circles,
 a rod as a thick line.
 """
