@@ -37,7 +37,10 @@ def forward_dynamics(model, q, u, t=0.0, method="jourdain"):
             model._fill_inputs(q, u, t)
         kernel = (kp.jourdain_accelerations_packed if method == "jourdain"
                   else kp.articulated_accelerations_packed)
-        pivot = kernel(*model._packed, q, u)
+        try:
+            pivot = kernel(*model._packed, q, u)
+        except ZeroDivisionError:
+            raise model._division_by_zero(q, t) from None
         if pivot >= 0:
             model._raise_singular(q, t, pivot)
         if pivot == -2:
@@ -78,7 +81,10 @@ def state_derivative(model, t, y, method="jourdain"):
     if model._python_inputs:
         model._fill_inputs(y[:model.nq], y[model.nq:], t)
     ydot = np.empty(model.nq + model.nu)
-    status = kernel(*model._packed, y, ydot)
+    try:
+        status = kernel(*model._packed, y, ydot)
+    except ZeroDivisionError:
+        raise model._division_by_zero(y[:model.nq], t) from None
     if status >= 0:
         model._raise_singular(y[:model.nq], t, status)
     if status == -2:

@@ -162,3 +162,15 @@ def lambdify_load(model, name, exprs):
     def load(t, q, u):
         return np.asarray(fn(t, *q, *u), dtype=float).reshape(3)
     return load
+
+
+def division_by_zero(model, q, t=0.0):
+    """The error to raise when a kernel divided by zero at the coordinates ``q``: a
+    quaternion of zero length (named, with what to give instead), else the division
+    itself, with the time and the state's coordinates."""
+    q = np.array(q, dtype=float).reshape(-1)
+    if q.shape == (model.nq,):
+        model.normalize_quaternions(q)          # raises, naming a zero quaternion
+    return NonFiniteError(f"model {model.name!r}, t={t:.6g}: a division by zero in the "
+                          "numeric kernels at this state; check the coordinates "
+                          f"({', '.join(model.coordinates)}) and the model's data")

@@ -57,7 +57,10 @@ def jourdain_packed(model, q, u, t):
     q, u = model._state(q, u)
     if model._python_inputs:
         model._fill_inputs(q, u, t)
-    kp.jourdain_accelerations_packed(*model._packed, q, u)
+    try:
+        kp.jourdain_accelerations_packed(*model._packed, q, u)
+    except ZeroDivisionError:
+        raise model._division_by_zero(q, t) from None
     return q, u
 
 

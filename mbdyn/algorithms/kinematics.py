@@ -54,9 +54,12 @@ def kinematics_kernel(model, q, u, t, ud=None):
     q, u = model._fill(q, u, t)
     if ud is not None:
         model._udfull[model._free_u] = ud
-    ke.kinematics_and_loads(*model._tree, model._mass, model._com, model.gravity,
-                            model._qfull, model._ufull, model._udfull, *model._loads_arrays,
-                            *model._kin_out, model._scratch)
+    try:
+        ke.kinematics_and_loads(*model._tree, model._mass, model._com, model.gravity,
+                                model._qfull, model._ufull, model._udfull,
+                                *model._loads_arrays, *model._kin_out, model._scratch)
+    except ZeroDivisionError:
+        raise model._division_by_zero(q, t) from None
     return q, u
 
 
@@ -122,5 +125,8 @@ def coordinate_rates(model, q, u):
     if not model._quaternions:
         return u.copy()
     qd = np.empty(model.nq)
-    kj.coordinate_rates(np.asarray(q, dtype=float), u, model._slots, qd)
+    try:
+        kj.coordinate_rates(np.asarray(q, dtype=float), u, model._slots, qd)
+    except ZeroDivisionError:
+        raise model._division_by_zero(q) from None
     return qd

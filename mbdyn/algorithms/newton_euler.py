@@ -36,7 +36,10 @@ def solve(model, q, u, t, dense=False):
     if not dense:
         if model._python_inputs:
             model._fill_inputs(q, u, t)
-        status = kp.newton_euler_tree_packed(*model._packed, q, u)
+        try:
+            status = kp.newton_euler_tree_packed(*model._packed, q, u)
+        except ZeroDivisionError:
+            raise model._division_by_zero(q, t) from None
         if status >= 0:
             model._raise_singular(q, t, status)
         x = np.concatenate([model._ud, model._lam])

@@ -154,6 +154,7 @@ class Model:
     _newton_euler = ne.solve
     _reactions_from = ne.reactions_from
     _raise_singular = diagnosis.raise_singular
+    _division_by_zero = inputs.division_by_zero
 
     # ------------------------------------------------------------------ the numeric API
     kinematics = motion.kinematics
