@@ -42,7 +42,7 @@ import warnings
 
 import numpy as np
 
-from .. import limits
+from .. import files, limits
 from ..errors import ModelError, SimulationError
 from .schedulers import make_scheduler
 
@@ -432,14 +432,23 @@ class _Table:
         return [dict(zip(self.header, r)) for r in rows[1:] if len(r) == len(self.header)]
 
     def open(self, done_rows):
-        os.makedirs(os.path.dirname(os.path.abspath(self.path)), exist_ok=True)
-        self.fh = open(self.path, "w", encoding="utf-8", newline="")
-        self.fh.write(FORMAT_LINE + self.spec + "\n")
+        """Start the table with the rows kept from a previous run: written whole beside
+        ``path`` and renamed over it (the old table stays until then; a symbolic link at
+        ``path`` is replaced, never written through), then appended to."""
+        fd, tmp = files.temporary(self.path)
+        self.fh = os.fdopen(fd, "w", encoding="utf-8", newline="")
         self.writer = csv.writer(self.fh, lineterminator="\n")
-        self.writer.writerow(self.header)
-        for r in done_rows:
-            self.writer.writerow([r.get(c, "") for c in self.header])
-        self._sync()
+        try:
+            self.fh.write(FORMAT_LINE + self.spec + "\n")
+            self.writer.writerow(self.header)
+            for r in done_rows:
+                self.writer.writerow([r.get(c, "") for c in self.header])
+            self._sync()
+        except BaseException:
+            self.close()
+            files.remove(tmp)
+            raise
+        files.replace(tmp, self.path)
 
     def write(self, row):
         self.writer.writerow([_fmt(row.get(c, "")) for c in self.header])
@@ -449,20 +458,21 @@ class _Table:
         self.fh.flush()
         os.fsync(self.fh.fileno())
 
+    def close(self):
+        if self.fh is not None:
+            self.fh.close()
+            self.fh = None
+
     def finish(self, rows):
-        """Rewrite the file sorted by member (atomically)."""
-        self.fh.close()
-        folder = os.path.dirname(os.path.abspath(self.path))
-        fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
-            fh.write(FORMAT_LINE + self.spec + "\n")
-            w = csv.writer(fh, lineterminator="\n")
-            w.writerow(self.header)
-            for r in rows:
-                w.writerow([_fmt(r.get(c, "")) for c in self.header])
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, self.path)
+        """Rewrite the file sorted by member (whole or not at all: ``files``)."""
+        self.close()
+        buf = io.StringIO()
+        buf.write(FORMAT_LINE + self.spec + "\n")
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(self.header)
+        for r in rows:
+            w.writerow([_fmt(r.get(c, "")) for c in self.header])
+        files.atomic_write(self.path, buf.getvalue())
 
 
 def read_table(path):
@@ -615,6 +625,8 @@ def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, f
     table = None
     if out is not None:
         csv_path = out if not str(out).endswith(".parquet") else str(out)[:-8] + ".csv"
+        os.makedirs(os.path.dirname(os.path.abspath(str(csv_path))), exist_ok=True)
+        files.check_target(csv_path, (".csv",), "table")
         table = _Table(str(csv_path), head, spec)
         done = table.read_done() if resume else []
         for r in done:
@@ -658,6 +670,8 @@ def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, f
     finally:
         if bar is not None:
             bar.close()
+        if table is not None:
+            table.close()
         sched.close()
     wall = time.perf_counter() - start
     ordered = [rows[i] for i in range(len(members))]
@@ -694,4 +708,5 @@ def write_parquet(path, header, rows):
         raise ModelError(f"{path}: writing Parquet needs pyarrow (pip install pyarrow); "
                          "the CSV beside it holds the same table") from None
     arrays = _as_arrays(header, rows)
-    pq.write_table(pa.table({c: list(arrays[c]) for c in header}), path)
+    with files.replacing(path) as tmp:
+        pq.write_table(pa.table({c: list(arrays[c]) for c in header}), tmp)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import files
 from ..errors import ModelError
 
 
@@ -70,7 +71,8 @@ def plot_sweep(result, quantity, path, axes=None, title=None, ax=None):
     ax.set_title(title or quantity)
     if fig is not None:
         fig.tight_layout()
-        fig.savefig(path)
+        with files.replacing(path) as tmp:      # a link at ``path`` is replaced
+            fig.savefig(tmp)
         plt.close(fig)
     return ax.figure
 
