@@ -181,3 +181,75 @@ def test_a_signal_between_the_renames_of_a_pair_acts_after_both(sig, handler, tm
     assert verify_results(out / "model.json")
     meta = json.loads((out / "model.json").read_text())
     assert meta["t_final"] == pytest.approx(0.4)               # the new pair
+
+
+# --- issue 29, item 9: a sweep leaves no temporary folder, however it ends
+
+def _leftovers(folder):
+    """What mbdyn left in the temporary folder ``folder``."""
+    return [n for n in os.listdir(folder) if n.startswith("mbdyn")]
+
+
+@pytest.mark.parametrize("scheduler", ["serial", "processes"])
+def test_a_finished_sweep_leaves_no_temporary_folder(scheduler, tmp_path):
+    (tmp_path / "model.toml").write_text(BASE)
+    tmpdir = tmp_path / "tmpdir"
+    tmpdir.mkdir()
+    proc = subprocess.run([sys.executable, "-m", "mbdyn", "sweep", "model.toml", "--grid",
+                           "parameters.l=0.4:0.5:2", "--scheduler", scheduler, "--workers",
+                           "1", "--out", "s.csv"], capture_output=True, text=True,
+                          timeout=300, cwd=tmp_path, env=dict(env(), TMPDIR=str(tmpdir)))
+    assert proc.returncode == 0, proc.stderr
+    assert _leftovers(tmpdir) == []
+
+
+def test_a_sweep_that_fails_leaves_no_temporary_folder(tmp_path, monkeypatch):
+    import tempfile
+    from mbdyn.analysis.sweep import run_member, sweep
+
+    class Breaks:
+        """Runs the first member, then fails (a lost worker, a bug)."""
+        name = "breaks"
+
+        def map_unordered(self, fn, tasks):
+            for i, task in enumerate(tasks):
+                if i:
+                    raise RuntimeError("the scheduler broke")
+                yield i, fn(task)
+
+        def close(self):
+            pass
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    (tmp_path / "model.toml").write_text(BASE)
+    with pytest.raises(RuntimeError, match="broke"):
+        sweep(str(tmp_path / "model.toml"), {"parameters.l": [0.4, 0.5]}, scheduler=Breaks())
+    assert _leftovers(tmp_path) == []
+    assert run_member                      # the worker function itself writes nothing either
+
+
+def test_an_interrupted_sweep_leaves_no_temporary_folder(tmp_path):
+    (tmp_path / "model.toml").write_text(BASE)
+    tmpdir = tmp_path / "tmpdir"
+    tmpdir.mkdir()
+    table = tmp_path / "s.csv"
+    proc = subprocess.Popen([sys.executable, "-m", "mbdyn", "sweep", "model.toml", "--grid",
+                             "parameters.l=0.4:0.5:400", "--out", str(table)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            cwd=tmp_path, env=dict(env(), TMPDIR=str(tmpdir)))
+    try:
+        import time
+        deadline = time.monotonic() + 200
+        while time.monotonic() < deadline and proc.poll() is None:
+            if table.exists() and len(table.read_text().splitlines()) >= 4:   # 2 members
+                break
+            time.sleep(0.05)
+        assert proc.poll() is None, "the sweep ended before it could be interrupted"
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err
+    assert _leftovers(tmpdir) == []

@@ -36,7 +36,6 @@ import json
 import math
 import os
 import sys
-import tempfile
 import time
 import warnings
 
@@ -150,23 +149,6 @@ def expand(overrides=None, cases=None):
 
 # --------------------------------------------------------------------------- one member
 
-_TEXT_FILES = {}
-
-
-def _model_file(text, name):
-    """A file holding ``text`` in this process's temporary directory (one per text)."""
-    key = hashlib.sha256(text.encode()).hexdigest()[:16]
-    path = _TEXT_FILES.get(key)
-    if path is None or not os.path.exists(path):
-        folder = os.path.join(tempfile.gettempdir(), f"mbdyn-sweep-{os.getpid()}-{key}")
-        os.makedirs(folder, exist_ok=True)
-        path = os.path.join(folder, os.path.basename(name) or "model.toml")
-        with open(path, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        _TEXT_FILES[key] = path
-    return path
-
-
 def _triples(fixed, overrides):
     """``(path, value, origin)`` for ``load_model``: the fixed ones, then the member's."""
     return ([(p, v, f"fixed {p}={v!r}") for p, v in fixed]
@@ -174,12 +156,14 @@ def _triples(fixed, overrides):
 
 
 def _load(task, member):
+    """The ``Scene`` of one member, from the model text the task carries (no file is
+    written: messages name the model file the sweep was given)."""
     from ..io.loader import load_model
-    path = _model_file(task["model_text"], task["model_name"])
     over = _triples(task["fixed"], member["overrides"])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return load_model(path, case=member["case"], overrides=over)
+        return load_model(task["model_name"], case=member["case"], overrides=over,
+                          text=task["model_text"])
 
 
 def _series(result, name):
@@ -582,12 +566,12 @@ def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, f
     Everything that can be checked is checked before any member runs: the paths, the
     range texts, the quantities, an empty sweep.
     """
-    from ..io.loader import load_model
+    from ..io.loader import decode_text, load_model, read_bytes
     path = getattr(model, "path", model)
     if cases is None and getattr(model, "case", None) is not None and not isinstance(model, str):
         cases = [model.case]
-    with open(path, encoding="utf-8") as fh:
-        text = fh.read()
+    # read once (every member gets this text); newlines as a text-mode read gives them
+    text = decode_text(read_bytes(path), str(path)).replace("\r\n", "\n").replace("\r", "\n")
     members = expand(overrides, cases)
     if out is not None and str(out).endswith(".parquet"):
         try:
@@ -604,7 +588,7 @@ def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, f
         over = _triples(fixed_list, member["overrides"])
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            scene = load_model(path, case=member["case"], overrides=over)
+            scene = load_model(path, case=member["case"], overrides=over, text=text)
         header = header or columns(scene, quantities)
     if batched:
         why = batchable(scene, quantities)
@@ -633,7 +617,7 @@ def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, f
             rows[int(r["member"])] = r
         table.open(done)
     todo = [m for m in members if m["index"] not in rows]
-    base = {"model_text": text, "model_name": os.path.basename(str(path)), "fixed": fixed_list,
+    base = {"model_text": text, "model_name": str(path), "fixed": fixed_list,
             "quantities": list(quantities)}
 
     def label(row):
