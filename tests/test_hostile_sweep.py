@@ -253,3 +253,177 @@ def test_an_interrupted_sweep_leaves_no_temporary_folder(tmp_path):
     assert proc.returncode == 130, err
     assert "Traceback" not in err
     assert _leftovers(tmpdir) == []
+
+
+# --- issue 29, item 3: the Python call refuses arguments of the wrong kind, naming them
+
+class Refuse:
+    """A scheduler that fails the test if any member is sent to it."""
+    name = "refuse"
+
+    def map_unordered(self, fn, tasks):
+        raise AssertionError("work started")
+
+    def close(self):
+        pass
+
+
+GRID = {"parameters.l": [0.4, 0.5]}
+
+#: id, keywords of ``sweep`` (model, overrides and scheduler have defaults), pattern
+SWEEP_API_CASES = [
+    ("scheduler-number", dict(scheduler=42), r"scheduler=42: not a scheduler"),
+    ("scheduler-object", dict(scheduler=object()), r"not a scheduler.*map_unordered"),
+    ("scheduler-unknown", dict(scheduler="threads"), r"unknown scheduler 'threads'"),
+    ("workers-negative", dict(workers=-1), r"workers=-1: give a whole number >= 1"),
+    ("workers-fraction", dict(workers=1.5), r"workers=1.5"),
+    ("workers-bool", dict(workers=True), r"workers=True"),
+    ("batch-size-negative", dict(batched=True, batch_size=-1), r"batch_size=-1"),
+    ("batch-size-zero", dict(batched=True, batch_size=0), r"batch_size=0"),
+    ("members-not-tables", dict(overrides=[1, 2]), r"overrides\[0\] is int 1, not a member"),
+    ("members-text", dict(overrides="parameters.l=1"), r"overrides must be a grid"),
+    ("members-number", dict(overrides=5), r"overrides must be a grid"),
+    ("members-other-paths", dict(overrides=[{"parameters.l": 1}, {"parameters.m": 1}]),
+     r"overrides\[1\] sets parameters.m but overrides\[0\] sets parameters.l"),
+    ("grid-path-number", dict(overrides={1: [1.0]}), r"grid path 1 \(int\)"),
+    ("quantities-text", dict(quantities="final"), r"quantities='final': give a list"),
+    ("quantities-numbers", dict(quantities=[1, 2]), r"quantities=\[1, 2\]"),
+    ("cases-text", dict(cases="a"), r"cases='a': give a list of case names"),
+    ("fixed-list", dict(fixed=["simulation.t_end=1"]), r"fixed=\['simulation.t_end=1'\]"),
+    ("fixed-path-number", dict(fixed={1: 2}), r"fixed path 1"),
+    ("out-number", dict(out=5), r"out=5: give the path"),
+    ("out-extension", dict(out="t.txt"), r"out='t.txt'.*\.csv"),
+    ("resume-without-out", dict(resume=True), r"resume=True needs out="),
+    ("model-number", dict(model=42), r"model must be the path of a model file"),
+    ("model-none", dict(model=None), r"model must be the path"),
+    ("require-columns-text", dict(require_columns="t_final"), r"require_columns="),
+]
+
+
+@pytest.mark.parametrize("case_id, kwargs, pattern", SWEEP_API_CASES,
+                         ids=[c[0] for c in SWEEP_API_CASES])
+def test_hostile_sweep_arguments(case_id, kwargs, pattern, tmp_path, monkeypatch):
+    from mbdyn.analysis.sweep import sweep
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "model.toml").write_text(BASE)
+    kwargs = dict(kwargs)
+    model = kwargs.pop("model", str(tmp_path / "model.toml"))
+    overrides = kwargs.pop("overrides", GRID)
+    kwargs.setdefault("scheduler", Refuse())
+    with pytest.raises(mb.ModelError, match=pattern):
+        sweep(model, overrides, **kwargs)
+    assert sorted(os.listdir(tmp_path)) == ["model.toml"]          # nothing written
+
+
+# --- issue 29, item 8: every output is checked before any work
+
+#: id, extra sweep options, pattern (the option and what to change)
+SWEEP_OUTPUT_CASES = [
+    ("plot-file-txt", ["--plot", "t_final", "--plot-file", "{tmp}/x.txt"],
+     r"--plot-file .*x.txt: unknown picture format '.txt'; use one of .png"),
+    ("plot-file-no-folder", ["--plot", "t_final", "--plot-file", "{tmp}/no/x.png"],
+     r"--plot-file .*x.png: the folder .*no does not exist"),
+    ("plot-file-folder", ["--plot", "t_final", "--plot-file", "{tmp}"],
+     r"--plot-file .*: unknown picture format"),
+    ("plot-beside-out-bad-column", ["--out", "{tmp}/s.csv", "--plot", "nope"],
+     r"nope: not a column"),
+    ("out-folder", ["--out", "{tmp}/d.csv"], r"--out .*d.csv: is a folder"),
+    ("parquet-folder", ["--out", "{tmp}/d.parquet"], r"d.parquet: is a folder"),
+]
+
+
+@pytest.mark.parametrize("case_id, extra, pattern", SWEEP_OUTPUT_CASES,
+                         ids=[c[0] for c in SWEEP_OUTPUT_CASES])
+def test_sweep_outputs_are_checked_before_any_work(case_id, extra, pattern, tmp_path, capsys,
+                                                   monkeypatch):
+    import mbdyn.analysis.sweep as sw
+    monkeypatch.setattr(sw, "make_scheduler", lambda *a: Refuse())   # no member may run
+    (tmp_path / "d.csv").mkdir()
+    (tmp_path / "d.parquet").mkdir()
+    code, out, err = run_main(SWEEP + extra, tmp_path, capsys)
+    assert code == 1, err
+    assert re.search(pattern, err), err
+    assert not (tmp_path / "s.csv").exists()
+
+
+def test_plot_sweep_checks_its_path_before_drawing(tmp_path):
+    pytest.importorskip("matplotlib")
+    from mbdyn.analysis.sweep import SweepResult
+    from mbdyn.viz.sweep_plots import plot_sweep
+    result = SweepResult(["member", "parameters.l", "t_final"],
+                         [{"member": 0, "parameters.l": 0.4, "t_final": 0.2}], None, {})
+    with pytest.raises(mb.ModelError, match=r"x.txt: unknown picture format '.txt'"):
+        plot_sweep(result, "t_final", tmp_path / "x.txt")
+
+
+# --- issue 29, item 7: two sweeps on one table: the second is refused, not a silent loss
+
+def _start_sweep(tmp_path, table, members=400, extra=()):
+    """A sweep in a subprocess writing ``table``; returns once it has written 2 rows."""
+    import time
+    proc = subprocess.Popen([sys.executable, "-m", "mbdyn", "sweep", "model.toml", "--grid",
+                             f"parameters.l=0.4:0.5:{members}", "--out", str(table),
+                             *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, cwd=tmp_path, env=env())
+    deadline = time.monotonic() + 200
+    while time.monotonic() < deadline and proc.poll() is None:
+        if table.exists() and len(table.read_text().splitlines()) >= 4:
+            return proc
+        time.sleep(0.05)
+    proc.kill()
+    proc.wait()
+    pytest.fail("the first sweep did not start within 200 s")
+
+
+def _stop(proc):
+    if proc.poll() is None:
+        proc.send_signal(signal.SIGINT)
+        try:
+            proc.communicate(timeout=60)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.communicate()
+
+
+def test_a_second_sweep_on_the_same_table_is_refused(tmp_path, capsys):
+    (tmp_path / "model.toml").write_text(BASE)
+    table = tmp_path / "s.csv"
+    first = _start_sweep(tmp_path, table)
+    try:
+        code, out, err = run_main(SWEEP + ["--out", str(table)], tmp_path, capsys)
+        assert code == 1, err
+        assert re.search(rf"s.csv: another process \(process {first.pid}\) is writing this "
+                         r"table now; wait for it to end or write elsewhere", err), err
+        assert first.poll() is None                       # the first sweep goes on ...
+        before = len(table.read_text().splitlines())
+        import time
+        time.sleep(1.0)
+        assert len(table.read_text().splitlines()) >= before  # ... its table intact
+        assert table.read_text().startswith("# mbdyn sweep table v1")
+    finally:
+        _stop(first)
+    assert first.returncode == 130
+    assert not (tmp_path / ".s.csv.lock").exists()          # released on the way out
+
+
+def test_the_lock_of_a_killed_sweep_is_taken_over(tmp_path, capsys):
+    (tmp_path / "model.toml").write_text(BASE)
+    table = tmp_path / "s.csv"
+    first = _start_sweep(tmp_path, table)
+    first.kill()                                           # SIGKILL: no clean-up at all
+    first.communicate(timeout=60)
+    assert (tmp_path / ".s.csv.lock").exists()
+    code, out, err = run_main(SWEEP + ["--out", str(table)], tmp_path, capsys)
+    assert code == 0, err
+    assert not (tmp_path / ".s.csv.lock").exists()
+    assert len(table.read_text().splitlines()) == 2 + 2
+
+
+def test_the_table_lock_refuses_a_second_holder_in_one_process(tmp_path):
+    from mbdyn.files import TableLock
+    with TableLock(tmp_path / "t.csv"):
+        with pytest.raises(mb.ModelError, match=rf"process {os.getpid()}\) is writing"):
+            TableLock(tmp_path / "t.csv").acquire()
+    assert os.listdir(tmp_path) == []
+    with TableLock(tmp_path / "t.csv"):                    # free again
+        pass

@@ -14,24 +14,53 @@ and yields ``(index, result)`` pairs in the order the tasks finish, and ``close(
 """
 from __future__ import annotations
 
+import numbers
 import os
 
 from ..errors import ModelError
 
 
+NAMES = ("serial", "processes", "dask")
+
+
 def make_scheduler(spec="serial", workers=None):
     """The scheduler named by ``spec`` (see the module docstring); ``workers``: the number
     of local worker processes (default: the number of cores)."""
+    check_spec(spec)
+    if workers is not None and (isinstance(workers, bool) or not isinstance(
+            workers, numbers.Integral) or workers < 1):
+        raise ModelError(f"workers={workers!r}: give a whole number >= 1 (local worker "
+                         "processes), or None for one per core")
     if not isinstance(spec, str):
         return spec                       # already a scheduler object
     if spec == "serial":
         return SerialScheduler()
     if spec == "processes":
         return ProcessScheduler(workers)
-    if spec == "dask" or spec.startswith("tcp://"):
-        return DaskScheduler(None if spec == "dask" else spec, workers)
-    raise ModelError(f"unknown scheduler {spec!r}; use serial, processes, dask or "
+    return DaskScheduler(None if spec == "dask" else spec, workers)
+
+
+def check_spec(spec):
+    """Refuse a scheduler ``spec`` that is neither one of ``NAMES``, an address
+    ``tcp://HOST:PORT`` nor a scheduler object (with ``map_unordered`` and ``close``),
+    before anything is started or connected."""
+    if not isinstance(spec, str):
+        if callable(getattr(spec, "map_unordered", None)) and callable(
+                getattr(spec, "close", None)):
+            return
+        raise ModelError(f"scheduler={_brief(spec)}: not a scheduler; give 'serial', "
+                         "'processes', 'dask', 'tcp://HOST:PORT' (an existing Dask "
+                         "scheduler) or an object with map_unordered(fn, tasks) and close()")
+    if spec in NAMES or spec.startswith("tcp://"):
+        return
+    raise ModelError(f"unknown scheduler {_brief(spec)}; use serial, processes, dask or "
                      "tcp://HOST:PORT (an existing Dask scheduler)")
+
+
+def _brief(value, width=40):
+    """``repr(value)``, shortened to ``width`` characters for a message."""
+    text = repr(value)
+    return text if len(text) <= width else text[:width - 3] + "..."
 
 
 def _cores():

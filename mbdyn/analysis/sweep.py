@@ -34,16 +34,18 @@ import io
 import itertools
 import json
 import math
+import numbers
 import os
 import sys
 import time
 import warnings
+from collections.abc import Iterable, Mapping
 
 import numpy as np
 
 from .. import files, limits
 from ..errors import ModelError, SimulationError
-from .schedulers import make_scheduler
+from .schedulers import check_spec, make_scheduler
 
 DEFAULT_QUANTITIES = ("final", "events", "t_final")
 STATS = ("max", "min", "absmax", "mean", "std")
@@ -121,9 +123,10 @@ def expand(overrides=None, cases=None):
     Returns ``[{"case": ..., "overrides": [[path, value], ...]}]``."""
     if overrides is None:
         combos = [[]]
-    elif isinstance(overrides, dict):
+    elif isinstance(overrides, Mapping):
         axes = []
         for path, values in overrides.items():
+            _check_path_text(path, "grid path")
             if isinstance(values, str):
                 values = parse_range(values, path)
             elif not isinstance(values, (list, tuple, np.ndarray)):
@@ -138,13 +141,51 @@ def expand(overrides=None, cases=None):
                              f"{limits.MAX_SWEEP_MEMBERS}; split it into several sweeps")
         combos = [list(c) for c in itertools.product(*axes)]
     else:
-        combos = [list(dict(m).items()) for m in overrides]
+        combos = _member_list(overrides)
     case_list = list(cases) if cases else [None]
     members = [{"case": c, "overrides": [[p, v] for p, v in combo]}
                for c in case_list for combo in combos]
     if not members:
         raise ModelError("the sweep has no members; give at least one override value")
     return members
+
+
+def _check_path_text(path, what):
+    """A dotted path given in Python must be text (``"parameters.Mz"``)."""
+    if not isinstance(path, str):
+        raise ModelError(f"sweep: {what} {path!r} ({type(path).__name__}) is not a dotted "
+                         "path such as 'parameters.Mz'")
+
+
+def _member_list(overrides):
+    """``[[(path, value), ...], ...]`` of a list of members ``{path: value}``, each setting
+    the same paths (their columns in the table)."""
+    if isinstance(overrides, (str, bytes)) or not isinstance(overrides, Iterable):
+        raise ModelError(f"sweep: overrides must be a grid {{path: values}} or a list of "
+                         f"members {{path: value}}, not {type(overrides).__name__} "
+                         f"{_brief(overrides)}")
+    combos = []
+    for k, m in enumerate(overrides):
+        if len(combos) >= limits.MAX_SWEEP_MEMBERS:
+            raise ModelError(f"the sweep has more than {limits.MAX_SWEEP_MEMBERS} members; "
+                             "split it into several sweeps")
+        if not isinstance(m, Mapping):
+            raise ModelError(f"sweep: overrides[{k}] is {type(m).__name__} {_brief(m)}, not a "
+                             "member {path: value}, e.g. {'parameters.Mz': -0.01}")
+        for p in m:
+            _check_path_text(p, f"overrides[{k}] path")
+        if combos and {p for p, _ in combos[0]} != set(m):
+            raise ModelError(f"sweep: overrides[{k}] sets {', '.join(m) or 'nothing'} but "
+                             f"overrides[0] sets {', '.join(p for p, _ in combos[0]) or 'nothing'}"
+                             "; every member sets the same paths (the table's columns)")
+        combos.append(list(m.items()))
+    return combos
+
+
+def _brief(value, width=40):
+    """``repr(value)``, shortened to ``width`` characters for a message."""
+    text = repr(value)
+    return text if len(text) <= width else text[:width - 3] + "..."
 
 
 # --------------------------------------------------------------------------- one member
@@ -556,33 +597,141 @@ def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, f
     ``quantities``: see the module docstring.  ``scheduler``: ``"serial"``,
     ``"processes"``, ``"dask"``, ``"tcp://HOST:PORT"`` or a scheduler object
     (``schedulers``); ``workers``: local worker count.  ``out``: the CSV to write as
-    members finish (``.parquet`` too if the name ends so and pyarrow is present);
-    ``resume``: keep the finished rows of ``out`` and run only the rest.
-    ``batched``: advance members that share one compiled model in one compiled call
-    (fixed-step schemes only; see ``batchable``), ``batch_size`` members per task.
-    ``progress``: show a bar on stderr (default: when stderr is a terminal).
+    members finish (``.parquet`` too if the name ends so and pyarrow is present), locked
+    against a second sweep meanwhile; ``resume``: keep the finished rows of ``out`` and
+    run only the rest.  ``batched``: advance members that share one compiled model in one
+    compiled call (fixed-step schemes only; see ``batchable``), ``batch_size`` members per
+    task.  ``progress``: show a counter on stderr (default: when stderr is a terminal).
     ``require_columns``: columns the caller will need (e.g. to plot), checked up front.
 
-    Everything that can be checked is checked before any member runs: the paths, the
-    range texts, the quantities, an empty sweep.
+    Everything that can be checked is checked before any member runs: the arguments, the
+    paths, the range texts, the quantities, an empty sweep, the table's name and folder.
+    A bad argument raises ``ModelError`` naming it.
     """
-    from ..io.loader import decode_text, load_model, read_bytes
-    path = getattr(model, "path", model)
-    if cases is None and getattr(model, "case", None) is not None and not isinstance(model, str):
-        cases = [model.case]
-    # read once (every member gets this text); newlines as a text-mode read gives them
-    text = decode_text(read_bytes(path), str(path)).replace("\r\n", "\n").replace("\r", "\n")
+    path, cases = _model_path(model, cases)
+    _check_arguments(scheduler, quantities, cases, fixed, workers, batch_size, out, resume,
+                     require_columns)
+    text = _model_text(path)
     members = expand(overrides, cases)
+    quantities = tuple(quantities)
+    fixed_list = [[p, v] for p, v in (fixed or {}).items()]
+    head = _header(path, text, members, fixed_list, quantities, cases, batched,
+                   require_columns)
+    for i, m in enumerate(members):
+        m["index"] = i
+    spec = hashlib.sha256(json.dumps([text, members, fixed_list, list(quantities)],
+                                     default=repr).encode()).hexdigest()[:20]
+    base = {"model_text": text, "model_name": str(path), "fixed": fixed_list,
+            "quantities": list(quantities)}
+    csv_path = _table_path(out)
+    lock = files.TableLock(csv_path) if csv_path else None
+    table = _Table(csv_path, head, spec) if csv_path else None
+    try:
+        if lock is not None:
+            lock.acquire()
+        rows = _kept_rows(table, resume)
+        sched = make_scheduler(scheduler, workers)
+        start = time.perf_counter()
+        todo = [m for m in members if m["index"] not in rows]
+        try:
+            if table is not None:
+                table.open(list(rows.values()))
+            _run(sched, todo, base, batched, batch_size, members, rows, table,
+                 _progress(len(members), _show_progress(progress) and bool(todo)), head)
+        finally:
+            if table is not None:
+                table.close()
+            sched.close()
+        wall = time.perf_counter() - start
+        ordered = [rows[i] for i in range(len(members))]
+        # rows read back from a file hold text: make them the same values as fresh rows
+        ordered = [{c: _typed(r.get(c, ""), c) for c in head} for r in ordered]
+        if table is not None:
+            table.finish(ordered)
+            if str(out).endswith(".parquet"):
+                write_parquet(str(out), head, ordered)
+    finally:
+        if lock is not None:
+            lock.release()
+    stats = {"members": len(members), "ran": len(todo), "wall_time_s": wall,
+             "scheduler": getattr(sched, "name", str(scheduler)), "batched": bool(batched)}
+    return SweepResult(head, ordered, csv_path, stats)
+
+
+def _model_path(model, cases):
+    """The model file's path (``model`` or a ``Scene``'s) and the cases to sweep (a
+    ``Scene``'s own case when none are given)."""
+    path = getattr(model, "path", model)
+    if not isinstance(path, (str, os.PathLike)):
+        raise ModelError(f"sweep: model must be the path of a model file (or a Scene loaded "
+                         f"from one), not {type(model).__name__} {_brief(model)}")
+    if cases is None and getattr(model, "case", None) is not None and not isinstance(
+            model, (str, os.PathLike)):
+        cases = [model.case]
+    return path, cases
+
+
+def _whole(value, at_least=1):
+    """Whether ``value`` is a whole number (not a bool) of at least ``at_least``."""
+    return isinstance(value, numbers.Integral) and not isinstance(value, bool) \
+        and value >= at_least
+
+
+def _check_arguments(scheduler, quantities, cases, fixed, workers, batch_size, out, resume,
+                     require_columns):
+    """Refuse arguments of the wrong kind, naming the argument and what to give."""
+    check_spec(scheduler)
+    if isinstance(quantities, str) or not isinstance(quantities, Iterable) or not all(
+            isinstance(q, str) for q in quantities):
+        raise ModelError(f"sweep: quantities={_brief(quantities)}: give a list of quantity "
+                         "names, e.g. ('final', 'max:theta')")
+    if cases is not None and (isinstance(cases, str) or not isinstance(cases, Iterable)):
+        raise ModelError(f"sweep: cases={_brief(cases)}: give a list of case names, e.g. "
+                         f"cases=[{_brief(cases)}]")
+    if fixed is not None and not isinstance(fixed, Mapping):
+        raise ModelError(f"sweep: fixed={_brief(fixed)}: give a table {{path: value}}, e.g. "
+                         "{'simulation.t_end': 10}")
+    for p in fixed or {}:
+        _check_path_text(p, "fixed path")
+    if workers is not None and not _whole(workers):
+        raise ModelError(f"sweep: workers={_brief(workers)}: give a whole number >= 1 (local "
+                         "worker processes), or None for one per core")
+    if batch_size is not None and not _whole(batch_size):
+        raise ModelError(f"sweep: batch_size={_brief(batch_size)}: give a whole number >= 1 "
+                         "(members per task), or None for an even share per worker")
+    if out is not None and not isinstance(out, (str, os.PathLike)):
+        raise ModelError(f"sweep: out={_brief(out)}: give the path of a .csv (or .parquet) "
+                         "table, or None")
+    if out is not None and not str(out).endswith((".csv", ".parquet")):
+        raise ModelError(f"sweep: out={str(out)!r}: the table is written as .csv (or "
+                         ".parquet); name the file so")
+    if resume and out is None:
+        raise ModelError("sweep: resume=True needs out= (the table to complete)")
+    if isinstance(require_columns, str) or not all(isinstance(c, str)
+                                                   for c in require_columns):
+        raise ModelError(f"sweep: require_columns={_brief(require_columns)}: give a list of "
+                         "column names")
     if out is not None and str(out).endswith(".parquet"):
         try:
             import pyarrow  # noqa: F401
         except ImportError:
             raise ModelError(f"{out}: writing Parquet needs pyarrow (pip install pyarrow); "
                              "or write a .csv") from None
-    fixed_list = [[p, v] for p, v in (fixed or {}).items()]
-    quantities = tuple(quantities)
-    # check before any work: load the first and the last member (every path appears in
-    # both; a value that only fails in the middle becomes that member's error)
+
+
+def _model_text(path):
+    """The model file's text, read once as ``load_model`` reads a file (a regular file,
+    bounded, UTF-8), newlines as a text-mode read gives them: every member gets it."""
+    from ..io.loader import decode_text, read_bytes
+    text = decode_text(read_bytes(path), str(path))
+    return text.replace("\r\n", "\n").replace("\r", "\n")
+
+
+def _header(path, text, members, fixed_list, quantities, cases, batched, require_columns):
+    """The table's columns, found by loading the first and the last member (every path
+    appears in both; a value that only fails in the middle becomes that member's error);
+    a sweep that cannot run batched, or lacks a required column, is refused here."""
+    from ..io.loader import load_model
     header = None
     for member in (members[0], members[-1]):
         over = _triples(fixed_list, member["overrides"])
@@ -595,79 +744,74 @@ def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, f
         if why:
             raise ModelError(f"cannot run batched: {why}; run without batching")
     paths = [p for p, _ in members[0]["overrides"]]
-    with_case = cases is not None and len(members) > 0 and len(set(m["case"] for m in members)) > 1
+    with_case = cases is not None and len(set(m["case"] for m in members)) > 1
     head = ["member"] + (["case"] if with_case else []) + paths + ["status", "error"] + header
     missing = [c for c in require_columns if c not in head]
     if missing:
         raise ModelError(f"{', '.join(missing)}: not a column of the table; the columns are: "
                          + ", ".join(head))
-    for i, m in enumerate(members):
-        m["index"] = i
-    spec = hashlib.sha256(json.dumps([text, members, fixed_list, list(quantities)],
-                                     default=repr).encode()).hexdigest()[:20]
-    rows = {}
-    table = None
-    if out is not None:
-        csv_path = out if not str(out).endswith(".parquet") else str(out)[:-8] + ".csv"
-        os.makedirs(os.path.dirname(os.path.abspath(str(csv_path))), exist_ok=True)
-        files.check_target(csv_path, (".csv",), "table")
-        table = _Table(str(csv_path), head, spec)
-        done = table.read_done() if resume else []
-        for r in done:
-            rows[int(r["member"])] = r
-        table.open(done)
-    todo = [m for m in members if m["index"] not in rows]
-    base = {"model_text": text, "model_name": str(path), "fixed": fixed_list,
-            "quantities": list(quantities)}
+    return head
 
-    def label(row):
-        m = members[row["member"]]
-        row.update({p: v for p, v in m["overrides"]})
-        if with_case:
-            row["case"] = m["case"]
-        return row
 
-    show = progress if progress is not None else bool(getattr(sys.stderr, "isatty",
-                                                              lambda: False)())
-    bar = _progress(len(members), show and bool(todo))
+def _table_path(out):
+    """The CSV of ``out`` (``NAME.csv`` for ``NAME.parquet``), its folder created and the
+    path checked before any work (``files.check_target``); None without ``out``."""
+    if out is None:
+        return None
+    csv_path = str(out)[:-8] + ".csv" if str(out).endswith(".parquet") else str(out)
+    os.makedirs(os.path.dirname(os.path.abspath(csv_path)), exist_ok=True)
+    files.check_target(csv_path, (".csv",), "table")
+    if str(out).endswith(".parquet"):
+        files.check_target(out, (".parquet",), "table")
+    return csv_path
+
+
+def _kept_rows(table, resume):
+    """``{member: row}`` of the rows a previous run wrote (``resume``), else empty."""
+    if table is None or not resume:
+        return {}
+    return {int(r["member"]): r for r in table.read_done()}
+
+
+def _show_progress(progress):
+    """Whether to show the counter: ``progress``, or by default when stderr is a terminal."""
+    if progress is not None:
+        return bool(progress)
+    return bool(getattr(sys.stderr, "isatty", lambda: False)())
+
+
+def _tasks(todo, base, batched, batch_size, sched):
+    """``(function, tasks)`` for the scheduler: one task per member, or per batch."""
+    if not batched:
+        return run_member, (dict(base, member=m) for m in todo)
+    share = 1 if getattr(sched, "name", "") == "serial" else max(1, getattr(sched, "workers", 1))
+    size = batch_size or max(1, math.ceil(len(todo) / share))
+    return run_batch_task, (dict(base, members=todo[k:k + size])
+                            for k in range(0, len(todo), size))
+
+
+def _run(sched, todo, base, batched, batch_size, members, rows, table, bar, head):
+    """Run the members ``todo``; each finished row is labelled with its member's overrides
+    (and case), kept in ``rows`` and written to ``table``."""
+    with_case = "case" in head
+    fn, tasks = _tasks(todo, base, batched, batch_size, sched)
     if bar is not None and rows:
         bar.update(len(rows))
-    sched = make_scheduler(scheduler, workers)
-    start = time.perf_counter()
     try:
-        if batched:
-            size = batch_size or max(1, math.ceil(len(todo) / max(1, getattr(
-                sched, "workers", 1) if sched.name != "serial" else 1)))
-            tasks = [dict(base, members=todo[k:k + size]) for k in range(0, len(todo), size)]
-            stream = ((i, r) for i, rs in sched.map_unordered(run_batch_task, tasks)
-                      for r in rs)
-        else:
-            tasks = [dict(base, member=m) for m in todo]
-            stream = sched.map_unordered(run_member, tasks)
-        for _, row in stream:
-            row = label(row)
-            rows[row["member"]] = row
-            if table is not None:
-                table.write(row)
-            if bar is not None:
-                bar.update(1)
+        for _, result in sched.map_unordered(fn, tasks):
+            for row in (result if batched else [result]):
+                m = members[row["member"]]
+                row.update({p: v for p, v in m["overrides"]})
+                if with_case:
+                    row["case"] = m["case"]
+                rows[row["member"]] = row
+                if table is not None:
+                    table.write(row)
+                if bar is not None:
+                    bar.update(1)
     finally:
         if bar is not None:
             bar.close()
-        if table is not None:
-            table.close()
-        sched.close()
-    wall = time.perf_counter() - start
-    ordered = [rows[i] for i in range(len(members))]
-    # rows read back from a file hold text: make them the same values as fresh rows
-    ordered = [{c: _typed(r.get(c, ""), c) for c in head} for r in ordered]
-    if table is not None:
-        table.finish(ordered)
-        if str(out).endswith(".parquet"):
-            write_parquet(str(out), head, ordered)
-    stats = {"members": len(members), "ran": len(todo), "wall_time_s": wall,
-             "scheduler": getattr(sched, "name", str(scheduler)), "batched": bool(batched)}
-    return SweepResult(head, ordered, table.path if table else None, stats)
 
 
 def _typed(v, column):

@@ -5,11 +5,14 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import sys
 
 from . import SUMMARIES
 from ..analysis.sweep import DEFAULT_QUANTITIES, parse_grid, sweep
+from ..viz.sweep_plots import FORMATS as PICTURES
 from ..errors import ModelError
+from ..files import check_target
 from ..io.schema import parse_set_value
 from .common import fmt, positive_int
 
@@ -62,6 +65,21 @@ def _fixed(items):
     return out
 
 
+def _check_outputs(out, plot_file):
+    """Every output checked before any member runs (format, not a folder, a writable
+    folder; matplotlib for a plot): nothing is lost to a bad name after the work."""
+    if out:
+        os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
+        check_target(out, (".csv", ".parquet"), "table", "--out")
+    if plot_file:
+        check_target(plot_file, PICTURES, "picture", "--plot-file")
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            raise ModelError("--plot needs matplotlib: pip install \"mbdyn[plot]\" (or "
+                             "pip install matplotlib)") from None
+
+
 def _json_value(v):
     if isinstance(v, float) and not math.isfinite(v):
         return None
@@ -82,6 +100,7 @@ def run(args):
                                    if args.plot and args.out else None)
     if args.plot and not plot_file:
         raise ModelError("--plot needs --out FILE or --plot-file PNG")
+    _check_outputs(args.out, plot_file)
     result = sweep(args.model, grid, tuple(args.quantities or DEFAULT_QUANTITIES),
                    cases=args.case, fixed=_fixed(args.fixed), scheduler=args.scheduler,
                    workers=args.workers, out=args.out, resume=args.resume,

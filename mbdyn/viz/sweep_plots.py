@@ -7,6 +7,8 @@ import numpy as np
 from .. import files
 from ..errors import ModelError
 
+FORMATS = (".png", ".pdf", ".svg")
+
 
 def _axis(values):
     """Numeric positions and tick labels of one grid axis (its distinct values in order)."""
@@ -22,8 +24,10 @@ def _axis(values):
 def plot_sweep(result, quantity, path, axes=None, title=None, ax=None):
     """Plot column ``quantity`` of a ``SweepResult`` over its grid ``axes`` (the override
     paths; default all): one axis a line, two a heat map (NaN cells -- no event, a failed
-    member -- left blank).  Writes ``path`` (PNG) unless ``ax`` is given; returns the
-    matplotlib figure."""
+    member -- left blank).  Writes ``path`` (.png, .pdf, .svg; checked first) unless ``ax``
+    is given; returns the matplotlib figure."""
+    if ax is None:
+        files.check_target(path, FORMATS, "picture")
     if quantity not in result.columns:
         raise ModelError(f"--plot {quantity}: not a column of the table; the columns are: "
                          + ", ".join(result.columns))
