@@ -427,3 +427,89 @@ def test_the_table_lock_refuses_a_second_holder_in_one_process(tmp_path):
     assert os.listdir(tmp_path) == []
     with TableLock(tmp_path / "t.csv"):                    # free again
         pass
+
+
+# --- issue 29, item 2: a resume file is input: read bounded, checked, errors name the line
+
+@pytest.fixture(scope="module")
+def finished_table(tmp_path_factory):
+    """The lines (bytes) of the table of ``SWEEP`` (2 members) as mbdyn writes it."""
+    from mbdyn.analysis.sweep import sweep
+    folder = tmp_path_factory.mktemp("table")
+    (folder / "model.toml").write_text(BASE)
+    sweep(str(folder / "model.toml"), GRID, out=str(folder / "s.csv"))
+    return (folder / "s.csv").read_bytes().splitlines(keepends=True)
+
+
+def _row(lines, k, **cells):
+    """``lines`` with cells of row ``k`` (0: the first member) replaced by name."""
+    header = lines[1].decode().rstrip("\n").split(",")
+    row = lines[2 + k].decode().rstrip("\n").split(",")
+    for name, value in cells.items():
+        row[header.index(name)] = value
+    return lines[:2 + k] + [",".join(row).encode() + b"\n"] + lines[3 + k:]
+
+
+#: id, the finished table's lines -> the file's bytes, pattern of the message
+RESUME_CASES = [
+    ("member-text", lambda ls: _row(ls, 0, member="abc"),
+     r"s.csv: line 3: member 'abc' is not a member number of this sweep \(0 to 1\)"),
+    ("member-fraction", lambda ls: _row(ls, 1, member="1.5"), r"line 4: member '1.5'"),
+    ("member-negative", lambda ls: _row(ls, 0, member="-1"), r"line 3: member '-1'"),
+    ("member-beyond", lambda ls: _row(ls, 1, member="7"), r"line 4: member '7'"),
+    ("member-unicode-digit", lambda ls: _row(ls, 0, member="\u0661"), r"line 3: member"),
+    ("member-twice", lambda ls: _row(ls, 1, member="0"), r"line 4: member 0 appears twice"),
+    ("status-unknown", lambda ls: _row(ls, 0, status="maybe"),
+     r"line 3: status 'maybe' is not one of ok, failed, error"),
+    ("quantity-text", lambda ls: _row(ls, 0, t_final="abc"),
+     r"line 3: t_final holds 'abc', not a number"),
+    ("override-changed", lambda ls: _row(ls, 1, **{"parameters.l": "9.0"}),
+     r"line 4: member 1's parameters.l is '9.0', the sweep's is '0.5'"),
+    ("cells-missing", lambda ls: ls[:2] + [b"0,0.4,ok\n"] + ls[3:],
+     r"line 3: has 3 cells, the table \d+ columns"),
+    ("not-utf8", lambda ls: ls[:2] + [ls[2][:-1] + b"\xff\xfe\n"] + ls[3:],
+     r"line 3: is not UTF-8 text \(invalid start byte at byte \d+\)"),
+    ("nul-byte", lambda ls: ls[:2] + [ls[2].replace(b",ok,", b",o\x00k,")] + ls[3:],
+     r"line 3: holds a NUL byte"),
+    ("line-20-mb", lambda ls: ls[:2] + [b"0,0.4,ok," + b"x" * 20_000_000 + b"\n"] + ls[3:],
+     r"line 3: is longer than 1000000 bytes"),
+    ("field-200-kb", lambda ls: _row(ls, 0, error="x" * 200_000), r"line 3: field larger"),
+    ("binary-first-line", lambda ls: [b"\x89PNG\r\n"] + ls[1:], r"line 1: is not UTF-8"),
+    ("another-sweep", lambda ls: [b"# mbdyn sweep table v1 spec=0000\n"] + ls[1:],
+     r"s.csv: not a table of this sweep"),
+]
+
+
+@pytest.mark.parametrize("case_id, corrupt, pattern", RESUME_CASES,
+                         ids=[c[0] for c in RESUME_CASES])
+def test_hostile_resume_files(case_id, corrupt, pattern, finished_table, tmp_path, capsys,
+                              monkeypatch):
+    import mbdyn.analysis.sweep as sw
+    monkeypatch.setattr(sw, "make_scheduler", lambda *a: Refuse())   # no member may run
+    table = tmp_path / "s.csv"
+    data = b"".join(corrupt(list(finished_table)))
+    table.write_bytes(data)
+    code, out, err = run_main(SWEEP + ["--out", str(table), "--resume"], tmp_path, capsys)
+    assert code == 1, err
+    assert re.search(pattern, err), err
+    assert len(err) < 1000 and len(err.strip().splitlines()) == 1
+    assert table.read_bytes() == data                       # left as it was
+
+
+def test_a_resume_file_that_is_a_fifo_is_refused_not_waited_on(tmp_path, capsys):
+    os.mkfifo(tmp_path / "s.csv")
+    code, out, err = run_main(SWEEP + ["--out", "{tmp}/s.csv", "--resume"], tmp_path, capsys)
+    assert code == 1 and "s.csv: is not a regular file" in err, err
+
+
+def test_a_row_cut_by_a_kill_is_run_again_and_a_whole_table_resumes(finished_table, tmp_path,
+                                                                    capsys):
+    table = tmp_path / "s.csv"
+    table.write_bytes(b"".join(finished_table[:3]) + finished_table[3][:-9])   # cut row
+    code, out, err = run_main(SWEEP + ["--out", str(table), "--resume"], tmp_path, capsys)
+    assert code == 0, err
+    assert "1 run now" in out
+    assert table.read_bytes() == b"".join(finished_table)
+    code, out, err = run_main(SWEEP + ["--out", str(table), "--resume"], tmp_path, capsys)
+    assert code == 0 and "0 run now" in out, err             # a finished table: nothing
+    assert table.read_bytes() == b"".join(finished_table)

@@ -36,6 +36,7 @@ import json
 import math
 import numbers
 import os
+import stat
 import sys
 import time
 import warnings
@@ -50,6 +51,7 @@ from .schedulers import check_spec, make_scheduler
 DEFAULT_QUANTITIES = ("final", "events", "t_final")
 STATS = ("max", "min", "absmax", "mean", "std")
 SIMPLE = ("final", "events", "t_final", "energy_drift", "steps", "rhs_evaluations")
+STATUSES = ("ok", "failed", "error")
 FORMAT_LINE = "# mbdyn sweep table v1 spec="
 
 
@@ -432,6 +434,58 @@ def _fmt(v):
     return "" if v is None else str(v)
 
 
+def _cell(v):
+    """The CSV cell of a table value."""
+    return _fmt(v)
+
+
+def _open_regular(path):
+    """``path`` opened for reading in binary if it is a regular file (a FIFO or a device
+    is refused, never waited on)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    except OSError as exc:
+        raise ModelError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        raise ModelError(f"{path}: is not a regular file (a FIFO, device or socket); give "
+                         "the sweep's table, or write elsewhere with --out")
+    if hasattr(os, "set_blocking"):
+        os.set_blocking(fd, True)
+    return os.fdopen(fd, "rb")
+
+
+def _table_lines(fh, path):
+    """The lines of a table file as text, each checked: at most ``limits.MAX_TABLE_LINE``
+    bytes, UTF-8, no NUL.  A last line without its newline (a row cut by a kill) is left
+    out: its member runs again."""
+    number = 0
+    while True:
+        raw = fh.readline(limits.MAX_TABLE_LINE + 1)
+        if not raw:
+            return
+        number += 1
+        if not raw.endswith(b"\n"):
+            if len(raw) > limits.MAX_TABLE_LINE:
+                raise _resume_error(path, number, f"is longer than {limits.MAX_TABLE_LINE} "
+                                    "bytes")
+            return
+        try:
+            text = raw.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            raise _resume_error(path, number, f"is not UTF-8 text ({exc.reason} at byte "
+                                f"{exc.start})") from None
+        if "\x00" in text:
+            raise _resume_error(path, number, "holds a NUL byte")
+        yield text
+
+
+def _resume_error(path, line, problem):
+    """The error of a table that cannot be resumed: its file, the line, what is wrong."""
+    return ModelError(f"{path}: line {line}: {problem}; this is not a table of this sweep "
+                      "as mbdyn writes it -- remove it, or write elsewhere with --out")
+
+
 class _Table:
     """The CSV written row by row: a format line with the sweep's fingerprint, the
     header, then one line per finished member (flushed and synced)."""
@@ -440,21 +494,66 @@ class _Table:
         self.path, self.header, self.spec = path, header, spec
         self.fh = None
 
-    def read_done(self):
-        """Rows of a previous run of the same sweep (resume); [] if none."""
-        if not os.path.exists(self.path):
+    def read_done(self, members):
+        """The rows a previous run of this sweep wrote (resume), read as the input they
+        are: a regular file, line by line (each at most ``limits.MAX_TABLE_LINE`` bytes,
+        UTF-8, no NUL), every row checked against the sweep's ``members``; errors name the
+        file and the line.  The rows' override and case cells are the members' own values.
+        [] if there is no table yet."""
+        if not os.path.lexists(self.path):
             return []
-        with open(self.path, encoding="utf-8", newline="") as fh:
-            text = fh.read()
-        lines = text.split("\n")
-        if not lines or lines[0] != FORMAT_LINE + self.spec:
-            raise ModelError(f"{self.path}: not a table of this sweep (model, grid, cases or "
-                             "quantities differ); remove it or write elsewhere with --out")
-        complete = "\n".join(lines[1:-1])          # the last piece lacks its newline
-        rows = list(csv.reader(io.StringIO(complete)))
-        if not rows or rows[0] != self.header:
-            return []
-        return [dict(zip(self.header, r)) for r in rows[1:] if len(r) == len(self.header)]
+        with _open_regular(self.path) as fh:
+            lines = _table_lines(fh, self.path)
+            if next(lines, "") != FORMAT_LINE + self.spec + "\n":
+                raise ModelError(f"{self.path}: not a table of this sweep (model, grid, "
+                                 "cases or quantities differ); remove it or write elsewhere "
+                                 "with --out")
+            reader = csv.reader(lines)
+            rows, seen = [], set()
+            try:
+                if next(reader, None) != self.header:
+                    return []                    # no row yet, or another mbdyn's columns
+                for cells in reader:     # at most one row per member (checked): bounded
+                    rows.append(self._kept_row(cells, reader.line_num + 1, members, seen))
+            except csv.Error as exc:
+                raise _resume_error(self.path, reader.line_num + 1, str(exc)) from None
+        return rows
+
+    def _kept_row(self, cells, line, members, seen):
+        """One row read back, checked: its size, member number, status, overrides and
+        numbers; returns it with the member's own override (and case) values."""
+        if len(cells) != len(self.header):
+            raise _resume_error(self.path, line, f"has {len(cells)} cells, the table "
+                                f"{len(self.header)} columns")
+        row = dict(zip(self.header, cells))
+        text = row["member"]
+        if not (text.isascii() and text.isdigit() and int(text) < len(members)):
+            raise _resume_error(self.path, line, f"member {_brief(text)} is not a member "
+                                f"number of this sweep (0 to {len(members) - 1})")
+        index = int(text)
+        if index in seen:
+            raise _resume_error(self.path, line, f"member {index} appears twice")
+        seen.add(index)
+        if row["status"] not in STATUSES:
+            raise _resume_error(self.path, line, f"status {_brief(row['status'])} is not one "
+                                f"of {', '.join(STATUSES)}")
+        member = members[index]
+        own = dict(member["overrides"], case=member["case"])
+        for column, value in own.items():
+            # as the live table wrote it, or as the finished one did (numbers as floats)
+            if column in row and row[column] not in (_cell(value), _cell(_typed(value, column))):
+                raise _resume_error(self.path, line, f"member {index}'s {column} is "
+                                    f"{_brief(row[column])}, the sweep's is {_cell(value)!r}")
+        kept = {"member": index, "status": row["status"], "error": row["error"]}
+        for column in self.header:
+            if column not in kept and column not in own:
+                number = _number(row[column])
+                if number is None:
+                    raise _resume_error(self.path, line, f"{column} holds "
+                                        f"{_brief(row[column])}, not a number")
+                kept[column] = number
+        kept.update((c, v) for c, v in own.items() if c in self.header)
+        return kept
 
     def open(self, done_rows):
         """Start the table with the rows kept from a previous run: written whole beside
@@ -467,7 +566,7 @@ class _Table:
             self.fh.write(FORMAT_LINE + self.spec + "\n")
             self.writer.writerow(self.header)
             for r in done_rows:
-                self.writer.writerow([r.get(c, "") for c in self.header])
+                self.writer.writerow([_cell(r.get(c, "")) for c in self.header])
             self._sync()
         except BaseException:
             self.close()
@@ -476,7 +575,7 @@ class _Table:
         files.replace(tmp, self.path)
 
     def write(self, row):
-        self.writer.writerow([_fmt(row.get(c, "")) for c in self.header])
+        self.writer.writerow([_cell(row.get(c, "")) for c in self.header])
         self._sync()
 
     def _sync(self):
@@ -496,7 +595,7 @@ class _Table:
         w = csv.writer(buf, lineterminator="\n")
         w.writerow(self.header)
         for r in rows:
-            w.writerow([_fmt(r.get(c, "")) for c in self.header])
+            w.writerow([_cell(r.get(c, "")) for c in self.header])
         files.atomic_write(self.path, buf.getvalue())
 
 
@@ -629,7 +728,7 @@ def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, f
     try:
         if lock is not None:
             lock.acquire()
-        rows = _kept_rows(table, resume)
+        rows = _kept_rows(table, resume, members)
         sched = make_scheduler(scheduler, workers)
         start = time.perf_counter()
         todo = [m for m in members if m["index"] not in rows]
@@ -766,11 +865,11 @@ def _table_path(out):
     return csv_path
 
 
-def _kept_rows(table, resume):
+def _kept_rows(table, resume, members):
     """``{member: row}`` of the rows a previous run wrote (``resume``), else empty."""
     if table is None or not resume:
         return {}
-    return {int(r["member"]): r for r in table.read_done()}
+    return {r["member"]: r for r in table.read_done(members)}
 
 
 def _show_progress(progress):
