@@ -513,3 +513,64 @@ def test_a_row_cut_by_a_kill_is_run_again_and_a_whole_table_resumes(finished_tab
     code, out, err = run_main(SWEEP + ["--out", str(table), "--resume"], tmp_path, capsys)
     assert code == 0 and "0 run now" in out, err             # a finished table: nothing
     assert table.read_bytes() == b"".join(finished_table)
+
+
+# --- issue 29, item 5: no text cell of a CSV mbdyn writes is a spreadsheet formula
+
+FORMULA_CASES = ["=cmd|' /C calc'!A0", "@SUM(A1:A9)", "+1+cmd|' /C calc'!A0", "'quoted"]
+FORMULA_MODEL = BASE + "".join(f'\n[cases."{name.replace(chr(92), chr(92) * 2)}"]\n'
+                               f"initial = {{ theta = 0.{k + 1} }}\n"
+                               for k, name in enumerate(FORMULA_CASES))
+#: the middle value is no expression: its members' rows are errors (text in every cell)
+FORMULA_GRID = '["-pi/8", "=HYPERLINK(\\"http://evil\\",\\"x\\")", "0.2"]'
+
+
+def _formula_cells(rows):
+    """The cells of CSV ``rows`` that a spreadsheet would evaluate as a formula."""
+    bad = []
+    for row in rows:
+        for cell in row:
+            try:
+                float(cell)
+                continue                      # a number stays a number, "-0.5" too
+            except ValueError:
+                pass
+            if cell.startswith(("=", "+", "-", "@", "\t", "\r")):
+                bad.append(cell)
+    return bad
+
+
+def test_sweep_tables_hold_no_spreadsheet_formula(tmp_path, capsys):
+    import csv
+    from mbdyn.analysis.sweep import read_table
+    argv = ["sweep", "{model}", "--grid", "initial.theta=" + FORMULA_GRID] + sum(
+        (["--case", name] for name in FORMULA_CASES), [])
+    code, out, err = run_main(argv + ["--out", "{tmp}/s.csv"], tmp_path, capsys,
+                              text=FORMULA_MODEL)
+    assert code == 0, err
+    text = (tmp_path / "s.csv").read_text()
+    rows = list(csv.reader(text.splitlines()[1:]))
+    assert _formula_cells(rows) == []
+    assert "'=cmd|' /C calc'!A0" in [r[1] for r in rows]            # escaped, not lost
+    statuses = [r[rows[0].index("status")] for r in rows[1:]]
+    assert statuses.count("error") == len(FORMULA_CASES)             # the middle value
+    # a reader gets the texts back exactly; a resume keeps the table byte for byte
+    table = read_table(str(tmp_path / "s.csv"))
+    assert list(dict.fromkeys(table["case"])) == FORMULA_CASES
+    assert table["initial.theta"][1].startswith("=HYPERLINK(")
+    code, out, err = run_main(argv + ["--out", "{tmp}/s.csv", "--resume"], tmp_path, capsys)
+    assert code == 0 and "0 run now" in out, err
+    assert (tmp_path / "s.csv").read_text() == text
+    # the table printed on stdout (no --out) is CSV too
+    code, out, err = run_main(argv, tmp_path, capsys)
+    assert code == 0, err
+    printed = list(csv.reader(out.splitlines()[1 + len(FORMULA_CASES):]))
+    assert printed[0][:2] == ["member", "case"] and _formula_cells(printed) == []
+
+
+def test_escaping_a_cell_is_undone_exactly():
+    from mbdyn.escape import spreadsheet_cell, spreadsheet_text
+    for text in FORMULA_CASES + ["plain", "", "''", "-", "'=x", "\t1"]:
+        cell = spreadsheet_cell(text)
+        assert not cell.startswith(("=", "+", "-", "@", "\t", "\r"))
+        assert spreadsheet_text(cell) == text

@@ -46,6 +46,7 @@ import numpy as np
 
 from .. import files, limits
 from ..errors import ModelError, SimulationError
+from ..escape import spreadsheet_cell, spreadsheet_text
 from .schedulers import check_spec, make_scheduler
 
 DEFAULT_QUANTITIES = ("final", "events", "t_final")
@@ -435,8 +436,9 @@ def _fmt(v):
 
 
 def _cell(v):
-    """The CSV cell of a table value."""
-    return _fmt(v)
+    """The CSV cell of a table value: a number as itself, a text escaped so that a
+    spreadsheet never reads it as a formula (``escape.spreadsheet_cell``)."""
+    return spreadsheet_cell(v) if isinstance(v, str) else _fmt(v)
 
 
 def _open_regular(path):
@@ -511,7 +513,7 @@ class _Table:
             reader = csv.reader(lines)
             rows, seen = [], set()
             try:
-                if next(reader, None) != self.header:
+                if next(reader, None) != [_cell(c) for c in self.header]:
                     return []                    # no row yet, or another mbdyn's columns
                 for cells in reader:     # at most one row per member (checked): bounded
                     rows.append(self._kept_row(cells, reader.line_num + 1, members, seen))
@@ -544,7 +546,8 @@ class _Table:
             if column in row and row[column] not in (_cell(value), _cell(_typed(value, column))):
                 raise _resume_error(self.path, line, f"member {index}'s {column} is "
                                     f"{_brief(row[column])}, the sweep's is {_cell(value)!r}")
-        kept = {"member": index, "status": row["status"], "error": row["error"]}
+        kept = {"member": index, "status": row["status"],
+                "error": spreadsheet_text(row["error"])}
         for column in self.header:
             if column not in kept and column not in own:
                 number = _number(row[column])
@@ -564,7 +567,7 @@ class _Table:
         self.writer = csv.writer(self.fh, lineterminator="\n")
         try:
             self.fh.write(FORMAT_LINE + self.spec + "\n")
-            self.writer.writerow(self.header)
+            self.writer.writerow([_cell(c) for c in self.header])
             for r in done_rows:
                 self.writer.writerow([_cell(r.get(c, "")) for c in self.header])
             self._sync()
@@ -593,19 +596,24 @@ class _Table:
         buf = io.StringIO()
         buf.write(FORMAT_LINE + self.spec + "\n")
         w = csv.writer(buf, lineterminator="\n")
-        w.writerow(self.header)
+        w.writerow([_cell(c) for c in self.header])
         for r in rows:
             w.writerow([_cell(r.get(c, "")) for c in self.header])
         files.atomic_write(self.path, buf.getvalue())
 
 
 def read_table(path):
-    """A sweep CSV as ``{column: array}`` (numbers as floats, text as objects)."""
-    with open(path, encoding="utf-8", newline="") as fh:
-        first = fh.readline()
-        if not first.startswith(FORMAT_LINE):
-            fh.seek(0)
-        rows = list(csv.reader(fh))
+    """A sweep CSV as ``{column: array}`` (numbers as floats, text as objects; the
+    escapes of text cells undone), read with the bounds of a resume."""
+    with _open_regular(path) as fh:
+        lines = _table_lines(fh, path)
+        reader = csv.reader(line for line in lines if not line.startswith(FORMAT_LINE))
+        try:
+            rows = [[spreadsheet_text(c) for c in r] for r in reader]
+        except csv.Error as exc:
+            raise ModelError(f"{path}: {exc}; not a table mbdyn wrote") from None
+    if not rows:
+        raise ModelError(f"{path}: is empty; not a table mbdyn wrote")
     header, body = rows[0], rows[1:]
     return _as_arrays(header, [dict(zip(header, r)) for r in body])
 

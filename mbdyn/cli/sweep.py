@@ -3,6 +3,7 @@
 The work is ``mbdyn.analysis.sweep``; this module only reads the command line."""
 from __future__ import annotations
 
+import csv
 import json
 import math
 import os
@@ -12,6 +13,7 @@ from . import SUMMARIES
 from ..analysis.sweep import DEFAULT_QUANTITIES, parse_grid, sweep
 from ..viz.sweep_plots import FORMATS as PICTURES
 from ..errors import ModelError
+from ..escape import spreadsheet_cell
 from ..files import check_target
 from ..io.schema import parse_set_value
 from .common import fmt, positive_int
@@ -125,9 +127,16 @@ def run(args):
     if args.plot:
         sys.stdout.write(f"  wrote {plot_file}\n")
     if not args.out and not args.plot:
-        cols = result.columns
-        sys.stdout.write(",".join(cols) + "\n")
-        for r in result.rows:
-            sys.stdout.write(",".join(fmt(r[c]) if isinstance(r[c], float) else str(r[c])
-                                      for c in cols) + "\n")
+        _print_table(result)
     return 0
+
+
+def _print_table(result):
+    """The table as CSV on stdout (briefly: 6 digits), text cells escaped as in every CSV
+    mbdyn writes (never a spreadsheet formula), numbers as numbers."""
+    writer = csv.writer(sys.stdout, lineterminator="\n")
+    writer.writerow([spreadsheet_cell(c) for c in result.columns])
+    for r in result.rows:
+        writer.writerow([spreadsheet_cell(v) if isinstance(v, str) else
+                         fmt(v) if isinstance(v, float) else str(v)
+                         for v in (r[c] for c in result.columns)])

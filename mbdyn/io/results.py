@@ -7,6 +7,7 @@ symbolic link at the final name is replaced, never written through.
 """
 from __future__ import annotations
 
+import csv
 import datetime
 import hashlib
 import io
@@ -18,6 +19,7 @@ import re
 import numpy as np
 
 from .. import files
+from ..escape import spreadsheet_cell
 
 AXES = ("x", "y", "z")
 WRENCH = ("Fx", "Fy", "Fz", "Mx", "My", "Mz")
@@ -164,7 +166,8 @@ def write_results(directory, scene, result, status="ok", error=None, extra=None)
     remove_stale_temporaries(directory, (stem + ".csv", stem + ".json"))
     names, table = columns(scene, result)
     buf = io.StringIO()
-    buf.write(",".join(names) + "\n")
+    # the header is the one text row: quoted as CSV needs, no cell a spreadsheet formula
+    csv.writer(buf, lineterminator="\n").writerow([spreadsheet_cell(n) for n in names])
     np.savetxt(buf, table, delimiter=",", fmt="%.15g")
     csv_text = buf.getvalue()
     csv_bytes = csv_text.encode("utf-8")
