@@ -68,3 +68,7 @@ MAX_SAMPLES = 2_000_000
 MAX_STEPS = 5_000_000
 #: wall-clock seconds of one run (None: no limit)
 MAX_WALL_TIME = None
+#: seconds of any one wait on a Dask scheduler at an address: the connection and its
+#: handshake, a finished member's result, the scheduler's answer to a check while members
+#: run (``sweep(scheduler_timeout=...)``, ``mbdyn sweep --scheduler-timeout``)
+SCHEDULER_TIMEOUT = 30.0

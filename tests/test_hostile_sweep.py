@@ -297,6 +297,10 @@ SWEEP_API_CASES = [
     ("model-number", dict(model=42), r"model must be the path of a model file"),
     ("model-none", dict(model=None), r"model must be the path"),
     ("require-columns-text", dict(require_columns="t_final"), r"require_columns="),
+    ("scheduler-timeout-negative", dict(scheduler_timeout=-1), r"scheduler_timeout=-1"),
+    ("scheduler-timeout-nan", dict(scheduler_timeout=float("nan")), r"scheduler_timeout=nan"),
+    ("address-no-port", dict(scheduler="tcp://"), r"scheduler 'tcp://': not an address"),
+    ("address-port-text", dict(scheduler="tcp://127.0.0.1:abc"), r"the port 'abc'"),
 ]
 
 
@@ -574,3 +578,151 @@ def test_escaping_a_cell_is_undone_exactly():
         cell = spreadsheet_cell(text)
         assert not cell.startswith(("=", "+", "-", "@", "\t", "\r"))
         assert spreadsheet_text(cell) == text
+
+
+# --- issue 29, item 1: a Dask scheduler address is checked, and every wait on it bounded
+
+class FakeScheduler:
+    """A loopback listener (a thread) that accepts and answers as ``mode`` says: never,
+    garbage, HTTP, a huge length prefix, a closed connection, or a small message that is
+    not Dask's handshake."""
+
+    ANSWERS = {"silent": None, "close": b"",
+               "garbage": b"\\x13\\x37garbage!!" * 10,
+               "http": b"HTTP/1.1 400 Bad Request\\r\\nContent-Length: 0\\r\\n\\r\\n",
+               "huge-length": (2 ** 62).to_bytes(8, "little"),
+               "small-junk": (24).to_bytes(8, "little") + b"\\x05" * 24}
+
+    def __init__(self, mode):
+        import socket
+        import threading
+        self.answer = self.ANSWERS[mode]
+        self.listener = socket.create_server(("127.0.0.1", 0))
+        self.address = f"tcp://127.0.0.1:{self.listener.getsockname()[1]}"
+        self.connections = []
+        threading.Thread(target=self._serve, daemon=True).start()
+
+    def _serve(self):
+        while True:
+            try:
+                conn, _ = self.listener.accept()
+            except OSError:                      # closed: the test is over
+                return
+            self.connections.append(conn)
+            if self.answer == b"":
+                conn.close()
+            elif self.answer is not None:
+                conn.sendall(self.answer)
+
+    def close(self):
+        self.listener.close()
+        for conn in self.connections:
+            conn.close()
+
+
+#: id, what the listener does, pattern of the message (after the address)
+FAKE_SCHEDULERS = [
+    ("accepts-never-answers", "silent", r"accepted the connection but did not answer "
+                                        r"within 2 s \(--scheduler-timeout\)"),
+    ("answers-garbage", "garbage", r"is not a Dask scheduler: its first message announces "
+                                   r"\d+ bytes"),
+    ("answers-http", "http", r"is not a Dask scheduler: its first message announces"),
+    ("announces-2-62-bytes", "huge-length", r"announces 4611686018427387904 bytes"),
+    ("closes-at-once", "close", r"closed the connection without the Dask handshake"),
+    ("small-junk", "small-junk", r"its first message is not the Dask handshake"),
+]
+
+
+@pytest.mark.parametrize("case_id, mode, pattern", FAKE_SCHEDULERS,
+                         ids=[c[0] for c in FAKE_SCHEDULERS])
+def test_a_scheduler_address_that_is_no_dask_scheduler_ends_in_bounded_time(
+        case_id, mode, pattern, tmp_path, capsys):
+    import time
+    pytest.importorskip("distributed")
+    fake = FakeScheduler(mode)
+    try:
+        start = time.monotonic()
+        code, out, err = run_main(SWEEP + ["--scheduler", fake.address,
+                                           "--scheduler-timeout", "2", "--out",
+                                           "{tmp}/s.csv"], tmp_path, capsys)
+        elapsed = time.monotonic() - start
+    finally:
+        fake.close()
+    assert code == 1, err
+    assert re.search(re.escape(fake.address) + r".*" + pattern, err), err
+    assert "out of memory" not in err and len(err.strip().splitlines()) == 1
+    assert elapsed < 60                        # model loading included; the wait is 2 s
+    assert not (tmp_path / "s.csv").exists()   # refused before the table was started
+
+
+#: malformed addresses: the option is named, exit code 2 (a bad command line)
+BAD_ADDRESSES = [
+    ("tcp://127.0.0.1:abc", r"the port 'abc' is not a whole number from 1 to 65535"),
+    ("tcp://", r"not an address tcp://HOST:PORT"),
+    ("tcp://:8786", r"not an address"),
+    ("tcp://127.0.0.1", r"not an address"),
+    ("tcp://127.0.0.1:0", r"the port '0'"),
+    ("tcp://127.0.0.1:99999", r"the port '99999'"),
+    ("tcp://127.0.0.1:8786/x", r"the port '8786/x'|not an address"),
+    ("tcp://me@127.0.0.1:8786", r"not an address"),
+    ("tcp://[::1:8786", r"not an address"),
+    ("tcp://127.0.0.1:\uff18\uff17", r"the port"),
+    ("udp://127.0.0.1:8786", r"unknown scheduler"),
+]
+
+
+@pytest.mark.parametrize("address, pattern", BAD_ADDRESSES, ids=[a for a, _ in BAD_ADDRESSES])
+def test_a_malformed_scheduler_address_is_refused_naming_the_option(address, pattern,
+                                                                    tmp_path, capsys):
+    code, out, err = run_main(SWEEP + ["--scheduler", address], tmp_path, capsys)
+    assert code == 2, err
+    assert "--scheduler" in err and re.search(pattern, err), err
+
+
+def test_a_real_scheduler_without_workers_or_stopped_ends_in_bounded_time(tmp_path):
+    """A real ``dask scheduler`` on loopback: with no workers the sweep ends after the
+    timeout; stopped (SIGSTOP) while members wait, the check finds it silent; stopped
+    before the sweep, the handshake times out."""
+    import socket
+    import time
+    pytest.importorskip("distributed")
+    from mbdyn.analysis.schedulers import DaskScheduler, probe
+    from mbdyn.analysis.sweep import sweep
+    (tmp_path / "model.toml").write_text(BASE)
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    address = f"tcp://127.0.0.1:{port}"
+    proc = subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler", "--host",
+                             "127.0.0.1", "--port", str(port), "--no-dashboard"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env())
+    try:
+        deadline = time.monotonic() + 90
+        while True:
+            try:
+                probe(address, 2)
+                break
+            except mb.ModelError:
+                assert time.monotonic() < deadline and proc.poll() is None, \
+                    "the Dask scheduler did not start within 90 s"
+                time.sleep(0.3)
+        start = time.monotonic()
+        with pytest.raises(mb.ModelError, match=re.escape(address) + r" has had no workers "
+                           r"for 2 s; start some with `dask worker"):
+            sweep(str(tmp_path / "model.toml"), GRID, scheduler=address, scheduler_timeout=2)
+        assert time.monotonic() - start < 30
+        client = DaskScheduler(address, timeout=2)
+        proc.send_signal(signal.SIGSTOP)
+        start = time.monotonic()
+        with pytest.raises(mb.ModelError, match=re.escape(address) + r" stopped answering"):
+            list(client.map_unordered(abs, [1, 2]))
+        client.close()
+        assert time.monotonic() - start < 30
+        start = time.monotonic()
+        with pytest.raises(mb.ModelError, match=r"accepted the connection but did not answer"):
+            sweep(str(tmp_path / "model.toml"), GRID, scheduler=address, scheduler_timeout=2)
+        assert time.monotonic() - start < 30
+    finally:
+        proc.send_signal(signal.SIGCONT)
+        proc.kill()
+        proc.wait()

@@ -693,7 +693,7 @@ def _progress(total, enabled):
 
 def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, fixed=None,
           scheduler="serial", workers=None, out=None, resume=False, batched=False,
-          batch_size=None, progress=None, require_columns=()):
+          batch_size=None, progress=None, require_columns=(), scheduler_timeout=None):
     """Run the model file ``model`` (a path or a ``Scene`` loaded from one) over
     ``overrides`` and return a ``SweepResult``.
 
@@ -710,6 +710,9 @@ def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, f
     compiled call (fixed-step schemes only; see ``batchable``), ``batch_size`` members per
     task.  ``progress``: show a counter on stderr (default: when stderr is a terminal).
     ``require_columns``: columns the caller will need (e.g. to plot), checked up front.
+    ``scheduler_timeout``: the longest wait, in seconds, on a Dask scheduler at an address
+    (connection, handshake, each result, each check that it still answers; default
+    ``limits.SCHEDULER_TIMEOUT``).
 
     Everything that can be checked is checked before any member runs: the arguments, the
     paths, the range texts, the quantities, an empty sweep, the table's name and folder.
@@ -717,7 +720,7 @@ def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, f
     """
     path, cases = _model_path(model, cases)
     _check_arguments(scheduler, quantities, cases, fixed, workers, batch_size, out, resume,
-                     require_columns)
+                     require_columns, scheduler_timeout)
     text = _model_text(path)
     members = expand(overrides, cases)
     quantities = tuple(quantities)
@@ -737,7 +740,7 @@ def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, f
         if lock is not None:
             lock.acquire()
         rows = _kept_rows(table, resume, members)
-        sched = make_scheduler(scheduler, workers)
+        sched = make_scheduler(scheduler, workers, scheduler_timeout)
         start = time.perf_counter()
         todo = [m for m in members if m["index"] not in rows]
         try:
@@ -785,9 +788,15 @@ def _whole(value, at_least=1):
 
 
 def _check_arguments(scheduler, quantities, cases, fixed, workers, batch_size, out, resume,
-                     require_columns):
+                     require_columns, scheduler_timeout):
     """Refuse arguments of the wrong kind, naming the argument and what to give."""
     check_spec(scheduler)
+    timeout = scheduler_timeout
+    if timeout is not None and not (isinstance(timeout, numbers.Real) and not isinstance(
+            timeout, bool) and math.isfinite(timeout) and timeout > 0):
+        raise ModelError(f"sweep: scheduler_timeout={_brief(scheduler_timeout)}: give a "
+                         "positive number of seconds, or None for "
+                         f"{limits.SCHEDULER_TIMEOUT:g}")
     if isinstance(quantities, str) or not isinstance(quantities, Iterable) or not all(
             isinstance(q, str) for q in quantities):
         raise ModelError(f"sweep: quantities={_brief(quantities)}: give a list of quantity "

@@ -3,6 +3,7 @@
 The work is ``mbdyn.analysis.sweep``; this module only reads the command line."""
 from __future__ import annotations
 
+import argparse
 import csv
 import json
 import math
@@ -10,13 +11,15 @@ import os
 import sys
 
 from . import SUMMARIES
+from .. import limits
+from ..analysis.schedulers import check_spec
 from ..analysis.sweep import DEFAULT_QUANTITIES, parse_grid, sweep
-from ..viz.sweep_plots import FORMATS as PICTURES
 from ..errors import ModelError
 from ..escape import spreadsheet_cell
 from ..files import check_target
 from ..io.schema import parse_set_value
-from .common import fmt, positive_int
+from ..viz.sweep_plots import FORMATS as PICTURES
+from .common import fmt, positive, positive_int
 
 
 def register(subparsers):
@@ -37,9 +40,12 @@ def register(subparsers):
                    help="what to keep per member: final, events, t_final, energy_drift, "
                         "steps, rhs_evaluations, max:X, min:X, absmax:X, mean:X, std:X "
                         f"(default: {', '.join(DEFAULT_QUANTITIES)})")
-    p.add_argument("--scheduler", default="serial", metavar="WHERE",
+    p.add_argument("--scheduler", default="serial", metavar="WHERE", type=scheduler_spec,
                    help="serial (default), processes, dask (a local Dask cluster) or "
                         "tcp://HOST:PORT (an existing Dask scheduler)")
+    p.add_argument("--scheduler-timeout", type=positive, metavar="S",
+                   help="the longest wait on a tcp:// scheduler: connecting, each result, "
+                        f"each check that it answers (default {limits.SCHEDULER_TIMEOUT:g} s)")
     p.add_argument("--workers", type=positive_int, metavar="N", help="local worker processes")
     p.add_argument("--batched", action="store_true",
                    help="advance members in one compiled call (fixed-step, no events)")
@@ -65,6 +71,15 @@ def _fixed(items):
         path, value = item.split("=", 1)
         out[path.strip()] = parse_set_value(value)
     return out
+
+
+def scheduler_spec(text):
+    """argparse type: a scheduler name or a well-formed address (nothing is connected)."""
+    try:
+        check_spec(text)
+    except ModelError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
 
 
 def _check_outputs(out, plot_file):
@@ -107,7 +122,8 @@ def run(args):
                    cases=args.case, fixed=_fixed(args.fixed), scheduler=args.scheduler,
                    workers=args.workers, out=args.out, resume=args.resume,
                    batched=args.batched, progress=False if args.json else None,
-                   require_columns=[args.plot] if args.plot else [])
+                   require_columns=[args.plot] if args.plot else [],
+                   scheduler_timeout=args.scheduler_timeout)
     if args.plot:
         from ..viz.sweep_plots import plot_sweep
         plot_sweep(result, args.plot, plot_file, axes=list(grid))
