@@ -726,3 +726,62 @@ def test_a_real_scheduler_without_workers_or_stopped_ends_in_bounded_time(tmp_pa
         proc.send_signal(signal.SIGCONT)
         proc.kill()
         proc.wait()
+
+
+# --- issue 29, item 10: a long sweep says how many members and about how long
+
+class Clock:
+    """A clock the test moves."""
+
+    def __init__(self):
+        self.now = 100.0
+
+    def __call__(self):
+        return self.now
+
+
+def test_a_million_member_sweep_is_announced_with_an_estimate():
+    import io
+    from mbdyn.analysis.sweep import _Progress
+    clock, stream = Clock(), io.StringIO()
+    progress = _Progress(1_000_000, 0, counter=True, stream=stream, clock=clock)
+    clock.now += 4.0                              # the first member: workers starting
+    progress.update()
+    for _ in range(2):                            # then 3.6 ms a member
+        clock.now += 0.0036
+        progress.update()
+    text = stream.getvalue()
+    assert re.search(r"^mbdyn sweep: 1000000 members to run; about 60 min left "
+                     r"\(0\.0036 s a member, from the first 3\)$", text, re.M), text
+    clock.now += 1.0
+    progress.update()
+    progress.close()
+    assert "\rmbdyn sweep: 4/1000000 members, 5 s, about 60 min left" in stream.getvalue()
+    assert stream.getvalue().endswith("\n")
+
+
+def test_a_short_sweep_says_nothing_and_a_slow_first_member_is_enough():
+    import io
+    from mbdyn.analysis.sweep import _Progress
+    clock, stream = Clock(), io.StringIO()
+    progress = _Progress(4, 0, counter=False, stream=stream, clock=clock)
+    for _ in range(4):
+        clock.now += 0.5
+        progress.update()
+    progress.close()
+    assert stream.getvalue() == ""                 # 2 s in all: nothing to announce
+    progress = _Progress(10, 2, counter=False, stream=stream, clock=clock)
+    clock.now += 30.0                              # one member took 30 s: 7 more to run
+    progress.update()
+    assert re.search(r"mbdyn sweep: 8 members to run \(2 kept from before\); about "
+                     r"3\.5 min left \(30 s a member, from the first 1\)",
+                     stream.getvalue()), stream.getvalue()
+
+
+def test_the_command_announces_a_long_sweep_on_stderr(tmp_path, capsys, monkeypatch):
+    import mbdyn.analysis.sweep as sw
+    monkeypatch.setattr(sw, "ANNOUNCE_AFTER", 0.0)  # every sweep is "long"
+    code, out, err = run_main(SWEEP + ["--json"], tmp_path, capsys)
+    assert code == 0, err
+    assert json.loads(out)["member"] == [0, 1]     # stdout: the JSON alone
+    assert re.search(r"^mbdyn sweep: 2 members to run; about .* left", err, re.M), err

@@ -670,25 +670,91 @@ class SweepResult:
         return f"<SweepResult {len(self.rows)} members ({bad} not ok), {self.columns}>"
 
 
-def _progress(total, enabled):
-    if not enabled:
-        return None
-    try:
-        from tqdm import tqdm
-        return tqdm(total=total, file=sys.stderr, unit="member", leave=False)
-    except ImportError:
-        class Bar:
-            def __init__(self):
-                self.n = 0
+#: a sweep whose members left would take longer than this many seconds is announced on
+#: stderr (members, estimated duration) once its first members have finished
+ANNOUNCE_AFTER = 10.0
+#: finished members timed before the estimate (fewer if the sweep is smaller, or if
+#: ANNOUNCE_AFTER seconds pass first)
+ESTIMATE_FROM = 3
 
-            def update(self, k):
-                self.n += k
-                sys.stderr.write(f"\rmbdyn sweep: {self.n}/{total} members")
-                sys.stderr.flush()
 
-            def close(self):
-                sys.stderr.write("\n")
-        return Bar()
+class _Progress:
+    """What a sweep tells on stderr while it runs.
+
+    * Once the first ``ESTIMATE_FROM`` members have finished (or ``ANNOUNCE_AFTER``
+      seconds have passed), the time per member is measured -- between the first and the
+      last finished member, so a worker's start-up does not count, or the first member's
+      whole time if only one finished -- and the rest extrapolated; if it comes to more
+      than ``ANNOUNCE_AFTER`` seconds, one line says how many members and about how long.
+    * ``counter``: a plain counter line, rewritten in place at most five times a second:
+      members done of all, time so far, about how long left.
+    """
+
+    def __init__(self, total, kept, counter, stream=None, clock=time.monotonic):
+        self.total, self.kept, self.done = total, kept, kept
+        self.todo = total - kept
+        self.counter = counter
+        self.stream = stream if stream is not None else sys.stderr
+        self.clock = clock
+        self.start = clock()
+        self.first = None                 # when the first member finished
+        self.per_member = None            # seconds, once estimated
+        self.shown = 0.0                  # when the counter was last written
+        self.counted = False
+
+    def update(self):
+        """One more member finished."""
+        now = self.clock()
+        self.done += 1
+        ran = self.done - self.kept
+        if self.first is None:
+            self.first = now
+        if self.per_member is None and (ran >= min(ESTIMATE_FROM, self.todo)
+                                        or now - self.start >= ANNOUNCE_AFTER):
+            self.per_member = ((now - self.first) / (ran - 1) if ran > 1
+                               else now - self.start)
+            left = self.per_member * (self.total - self.done)
+            if left > ANNOUNCE_AFTER:
+                self._line(f"mbdyn sweep: {self.todo} members to run"
+                           + (f" ({self.kept} kept from before)" if self.kept else "")
+                           + f"; about {_duration(left)} left ({_duration(self.per_member)}"
+                           f" a member, from the first {ran})")
+        if self.counter and (now - self.shown >= 0.2 or self.done == self.total):
+            self.shown = now
+            left = (f", about {_duration(self.per_member * (self.total - self.done))} left"
+                    if self.per_member is not None and self.done < self.total else "")
+            self.stream.write(f"\rmbdyn sweep: {self.done}/{self.total} members, "
+                              f"{_duration(now - self.start)}{left}   ")
+            self.stream.flush()
+            self.counted = True
+
+    def _line(self, text):
+        """``text`` as a line of its own (after the counter's line, if one is shown)."""
+        self.stream.write(("\n" if self.counted else "") + text + "\n")
+        self.stream.flush()
+        self.counted = False
+
+    def close(self):
+        if self.counted:
+            self.stream.write("\n")
+            self.stream.flush()
+            self.counted = False
+
+
+def _duration(seconds):
+    """A duration for people: ``0.2 s``, ``42 s``, ``3.5 min``, ``58 min``, ``1.5 h``,
+    ``3.2 days``."""
+    if seconds < 10:
+        return f"{seconds:.2g} s"
+    if seconds < 120:
+        return f"{seconds:.0f} s"
+    if seconds < 600:
+        return f"{seconds / 60:.1f} min"
+    if seconds < 7200:
+        return f"{seconds / 60:.0f} min"
+    if seconds < 172800:
+        return f"{seconds / 3600:.1f} h"
+    return f"{seconds / 86400:.1f} days"
 
 
 def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, fixed=None,
@@ -708,7 +774,8 @@ def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, f
     against a second sweep meanwhile; ``resume``: keep the finished rows of ``out`` and
     run only the rest.  ``batched``: advance members that share one compiled model in one
     compiled call (fixed-step schemes only; see ``batchable``), ``batch_size`` members per
-    task.  ``progress``: show a counter on stderr (default: when stderr is a terminal).
+    task.  ``progress``: a counter on stderr (default: when stderr is a terminal; a long
+    sweep is announced with an estimate of its duration either way; False: nothing).
     ``require_columns``: columns the caller will need (e.g. to plot), checked up front.
     ``scheduler_timeout``: the longest wait, in seconds, on a Dask scheduler at an address
     (connection, handshake, each result, each check that it still answers; default
@@ -746,8 +813,9 @@ def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, f
         try:
             if table is not None:
                 table.open(list(rows.values()))
-            _run(sched, todo, base, batched, batch_size, members, rows, table,
-                 _progress(len(members), _show_progress(progress) and bool(todo)), head)
+            if todo:
+                _run(sched, todo, base, batched, batch_size, members, rows, table,
+                     _progress(len(members), len(rows), progress), head)
         finally:
             if table is not None:
                 table.close()
@@ -889,11 +957,14 @@ def _kept_rows(table, resume, members):
     return {r["member"]: r for r in table.read_done(members)}
 
 
-def _show_progress(progress):
-    """Whether to show the counter: ``progress``, or by default when stderr is a terminal."""
-    if progress is not None:
-        return bool(progress)
-    return bool(getattr(sys.stderr, "isatty", lambda: False)())
+def _progress(total, kept, progress):
+    """The sweep's ``_Progress`` (None for ``progress=False``: nothing on stderr); its
+    counter shown for ``progress=True``, or by default when stderr is a terminal."""
+    if progress is False:
+        return None
+    counter = bool(progress) if progress is not None else bool(
+        getattr(sys.stderr, "isatty", lambda: False)())
+    return _Progress(total, kept, counter)
 
 
 def _tasks(todo, base, batched, batch_size, sched):
@@ -911,8 +982,6 @@ def _run(sched, todo, base, batched, batch_size, members, rows, table, bar, head
     (and case), kept in ``rows`` and written to ``table``."""
     with_case = "case" in head
     fn, tasks = _tasks(todo, base, batched, batch_size, sched)
-    if bar is not None and rows:
-        bar.update(len(rows))
     try:
         for _, result in sched.map_unordered(fn, tasks):
             for row in (result if batched else [result]):
@@ -924,7 +993,7 @@ def _run(sched, todo, base, batched, batch_size, members, rows, table, bar, head
                 if table is not None:
                     table.write(row)
                 if bar is not None:
-                    bar.update(1)
+                    bar.update()
     finally:
         if bar is not None:
             bar.close()

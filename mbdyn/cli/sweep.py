@@ -59,7 +59,8 @@ def register(subparsers):
     p.add_argument("--plot-file", metavar="PNG", help="where --plot writes")
     p.add_argument("--json", action="store_true",
                    help="print the table as one JSON object {column: [values]} and nothing "
-                        "else on stdout (no progress bar)")
+                        "else on stdout (the progress counter and a long sweep's estimate go "
+                        "to stderr)")
     p.set_defaults(func=run)
 
 
@@ -121,7 +122,7 @@ def run(args):
     result = sweep(args.model, grid, tuple(args.quantities or DEFAULT_QUANTITIES),
                    cases=args.case, fixed=_fixed(args.fixed), scheduler=args.scheduler,
                    workers=args.workers, out=args.out, resume=args.resume,
-                   batched=args.batched, progress=False if args.json else None,
+                   batched=args.batched, progress=None,
                    require_columns=[args.plot] if args.plot else [],
                    scheduler_timeout=args.scheduler_timeout)
     if args.plot:
