@@ -785,3 +785,22 @@ def test_the_command_announces_a_long_sweep_on_stderr(tmp_path, capsys, monkeypa
     assert code == 0, err
     assert json.loads(out)["member"] == [0, 1]     # stdout: the JSON alone
     assert re.search(r"^mbdyn sweep: 2 members to run; about .* left", err, re.M), err
+
+
+@pytest.mark.parametrize("argv", [
+    ["campbell", "{model}", "--parameter", "l", "--values", "0.4:0.5:2", "--not-spin",
+     "--plot", "{tmp}/c.txt"],
+    ["accuracy", "{model}", "--plot", "{tmp}/c.txt"],
+], ids=["campbell", "accuracy"])
+def test_diagram_paths_are_checked_before_the_work(argv, tmp_path, capsys, monkeypatch):
+    import importlib
+
+    def no_work(*args, **kwargs):
+        raise AssertionError("work started")
+    monkeypatch.setattr(importlib.import_module("mbdyn.analysis.campbell"), "campbell",
+                        no_work)
+    monkeypatch.setattr(importlib.import_module("mbdyn.cli.accuracy"), "accuracy_study",
+                        no_work)
+    code, out, err = run_main(argv, tmp_path, capsys)
+    assert code == 1, err
+    assert re.search(r"--plot .*c.txt: unknown picture format '.txt'", err), err

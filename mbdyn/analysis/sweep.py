@@ -822,7 +822,7 @@ def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, f
             sched.close()
         wall = time.perf_counter() - start
         ordered = [rows[i] for i in range(len(members))]
-        # rows read back from a file hold text: make them the same values as fresh rows
+        # kept and fresh rows as the same values (numbers as floats, texts as texts)
         ordered = [{c: _typed(r.get(c, ""), c) for c in head} for r in ordered]
         if table is not None:
             table.finish(ordered)
