@@ -15,6 +15,9 @@ as the literal text the user typed, never as markup, script or math:
 * ``spreadsheet_cell``: a text cell of a CSV table; a cell that starts with ``= + - @`` or
   a tab/carriage return is a formula to a spreadsheet (``=HYPERLINK(...)``), so it gets a
   leading apostrophe, as OWASP's CSV-injection advice says.  Numbers are not text cells.
+  A text that starts with an apostrophe itself gets one more, so that the escape can be
+  undone exactly: ``spreadsheet_text`` (a reader of mbdyn's tables) drops one leading
+  apostrophe.
 """
 from __future__ import annotations
 
@@ -47,4 +50,10 @@ FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")
 def spreadsheet_cell(text) -> str:
     """A text cell that a spreadsheet shows as text, never evaluates as a formula."""
     text = str(text)
-    return "'" + text if text.startswith(FORMULA_STARTS) else text
+    return "'" + text if text.startswith(FORMULA_STARTS + ("'",)) else text
+
+
+def spreadsheet_text(cell) -> str:
+    """The text that ``spreadsheet_cell`` made ``cell`` from (its inverse)."""
+    cell = str(cell)
+    return cell[1:] if cell.startswith("'") else cell

@@ -42,6 +42,9 @@ MAX_NAME_LENGTH = 100
 MAX_RANGE_POINTS = 100_000
 #: members of one sweep (the product of its axes, times its cases)
 MAX_SWEEP_MEMBERS = 1_000_000
+#: bytes of one line of a sweep table read back to resume it (a row of a 10 000-column
+#: table is ~250 kB; a longer line is not a table mbdyn wrote)
+MAX_TABLE_LINE = 1_000_000
 
 
 
@@ -65,3 +68,7 @@ MAX_SAMPLES = 2_000_000
 MAX_STEPS = 5_000_000
 #: wall-clock seconds of one run (None: no limit)
 MAX_WALL_TIME = None
+#: seconds of any one wait on a Dask scheduler at an address: the connection and its
+#: handshake, a finished member's result, the scheduler's answer to a check while members
+#: run (``sweep(scheduler_timeout=...)``, ``mbdyn sweep --scheduler-timeout``)
+SCHEDULER_TIMEOUT = 30.0

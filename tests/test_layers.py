@@ -15,7 +15,7 @@ PACKAGE = Path(__file__).resolve().parent.parent / "mbdyn"
 #: bottom to top: a module may import from its own layer and the layers below
 LAYERS = [
     # the package itself imports its public names on first use only (PEP 562)
-    ("ground", ["mbdyn.errors", "mbdyn.limits", "mbdyn.names", "mbdyn.escape"]),
+    ("ground", ["mbdyn.errors", "mbdyn.limits", "mbdyn.names", "mbdyn.escape", "mbdyn.files"]),
     ("kernels", ["mbdyn.kernels"]),
     ("elements", ["mbdyn.elements"]),
     ("algorithms", ["mbdyn.algorithms"]),

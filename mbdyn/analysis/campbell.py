@@ -116,7 +116,9 @@ class Campbell:
             ax.legend(fontsize=8, loc="upper left")
         fig.tight_layout()
         if path is not None:
-            fig.savefig(path, dpi=120)
+            from ..files import replacing
+            with replacing(path) as tmp:        # a link at ``path`` is replaced
+                fig.savefig(tmp, dpi=120)
             plt.close(fig)
         return fig
 

@@ -8,6 +8,7 @@ import sys
 from . import SUMMARIES
 from ..analysis.accuracy import DEFAULT_INTEGRATORS, TOLERANCES, accuracy_study
 from ..errors import ModelError
+from ..files import check_target, replacing
 from ..integrate.settings import INTEGRATORS
 from .common import add_model_arguments, load, positive, positive_int
 
@@ -72,6 +73,7 @@ def run(args):
     tolerances = _floats(args.tolerances, "tolerances") if args.tolerances else TOLERANCES
     steps = _floats(args.steps, "steps") if args.steps else None
     if args.plot:
+        check_target(args.plot, (".png", ".pdf", ".svg"), "picture", "--plot")
         _require_matplotlib()
 
     def progress(run):
@@ -131,5 +133,6 @@ def plot(study, path, title=""):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    with replacing(path) as tmp:            # a link at ``path`` is replaced
+        fig.savefig(tmp, dpi=110)
     plt.close(fig)

@@ -39,6 +39,9 @@ def register(subparsers):
 def run(args):
     from ..analysis.campbell import campbell
     from ..errors import ModelError
+    from ..files import check_target
+    if args.plot:                        # before the work: a bad path costs nothing
+        check_target(args.plot, (".png", ".pdf", ".svg"), "picture", "--plot")
     scene = load(args)
     try:
         orders = [int(o) for o in names(args.orders)]

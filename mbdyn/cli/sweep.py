@@ -3,15 +3,23 @@
 The work is ``mbdyn.analysis.sweep``; this module only reads the command line."""
 from __future__ import annotations
 
+import argparse
+import csv
 import json
 import math
+import os
 import sys
 
 from . import SUMMARIES
+from .. import limits
+from ..analysis.schedulers import check_spec
 from ..analysis.sweep import DEFAULT_QUANTITIES, parse_grid, sweep
 from ..errors import ModelError
+from ..escape import spreadsheet_cell
+from ..files import check_target
 from ..io.schema import parse_set_value
-from .common import fmt, positive_int
+from ..viz.sweep_plots import FORMATS as PICTURES
+from .common import fmt, positive, positive_int
 
 
 def register(subparsers):
@@ -32,9 +40,12 @@ def register(subparsers):
                    help="what to keep per member: final, events, t_final, energy_drift, "
                         "steps, rhs_evaluations, max:X, min:X, absmax:X, mean:X, std:X "
                         f"(default: {', '.join(DEFAULT_QUANTITIES)})")
-    p.add_argument("--scheduler", default="serial", metavar="WHERE",
+    p.add_argument("--scheduler", default="serial", metavar="WHERE", type=scheduler_spec,
                    help="serial (default), processes, dask (a local Dask cluster) or "
                         "tcp://HOST:PORT (an existing Dask scheduler)")
+    p.add_argument("--scheduler-timeout", type=positive, metavar="S",
+                   help="the longest wait on a tcp:// scheduler: connecting, each result, "
+                        f"each check that it answers (default {limits.SCHEDULER_TIMEOUT:g} s)")
     p.add_argument("--workers", type=positive_int, metavar="N", help="local worker processes")
     p.add_argument("--batched", action="store_true",
                    help="advance members in one compiled call (fixed-step, no events)")
@@ -48,7 +59,8 @@ def register(subparsers):
     p.add_argument("--plot-file", metavar="PNG", help="where --plot writes")
     p.add_argument("--json", action="store_true",
                    help="print the table as one JSON object {column: [values]} and nothing "
-                        "else on stdout (no progress bar)")
+                        "else on stdout (the progress counter and a long sweep's estimate go "
+                        "to stderr)")
     p.set_defaults(func=run)
 
 
@@ -60,6 +72,30 @@ def _fixed(items):
         path, value = item.split("=", 1)
         out[path.strip()] = parse_set_value(value)
     return out
+
+
+def scheduler_spec(text):
+    """argparse type: a scheduler name or a well-formed address (nothing is connected)."""
+    try:
+        check_spec(text)
+    except ModelError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
+
+def _check_outputs(out, plot_file):
+    """Every output checked before any member runs (format, not a folder, a writable
+    folder; matplotlib for a plot): nothing is lost to a bad name after the work."""
+    if out:
+        os.makedirs(os.path.dirname(os.path.abspath(out)), exist_ok=True)
+        check_target(out, (".csv", ".parquet"), "table", "--out")
+    if plot_file:
+        check_target(plot_file, PICTURES, "picture", "--plot-file")
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            raise ModelError("--plot needs matplotlib: pip install \"mbdyn[plot]\" (or "
+                             "pip install matplotlib)") from None
 
 
 def _json_value(v):
@@ -82,11 +118,13 @@ def run(args):
                                    if args.plot and args.out else None)
     if args.plot and not plot_file:
         raise ModelError("--plot needs --out FILE or --plot-file PNG")
+    _check_outputs(args.out, plot_file)
     result = sweep(args.model, grid, tuple(args.quantities or DEFAULT_QUANTITIES),
                    cases=args.case, fixed=_fixed(args.fixed), scheduler=args.scheduler,
                    workers=args.workers, out=args.out, resume=args.resume,
-                   batched=args.batched, progress=False if args.json else None,
-                   require_columns=[args.plot] if args.plot else [])
+                   batched=args.batched, progress=None,
+                   require_columns=[args.plot] if args.plot else [],
+                   scheduler_timeout=args.scheduler_timeout)
     if args.plot:
         from ..viz.sweep_plots import plot_sweep
         plot_sweep(result, args.plot, plot_file, axes=list(grid))
@@ -106,9 +144,16 @@ def run(args):
     if args.plot:
         sys.stdout.write(f"  wrote {plot_file}\n")
     if not args.out and not args.plot:
-        cols = result.columns
-        sys.stdout.write(",".join(cols) + "\n")
-        for r in result.rows:
-            sys.stdout.write(",".join(fmt(r[c]) if isinstance(r[c], float) else str(r[c])
-                                      for c in cols) + "\n")
+        _print_table(result)
     return 0
+
+
+def _print_table(result):
+    """The table as CSV on stdout (briefly: 6 digits), text cells escaped as in every CSV
+    mbdyn writes (never a spreadsheet formula), numbers as numbers."""
+    writer = csv.writer(sys.stdout, lineterminator="\n")
+    writer.writerow([spreadsheet_cell(c) for c in result.columns])
+    for r in result.rows:
+        writer.writerow([spreadsheet_cell(v) if isinstance(v, str) else
+                         fmt(v) if isinstance(v, float) else str(v)
+                         for v in (r[c] for c in result.columns)])

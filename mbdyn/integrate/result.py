@@ -73,25 +73,18 @@ class Result:
                 names += [f"point_{p}_{a}" for a in "xyz"]
                 cols.append(np.asarray(arr))
         table = np.hstack([np.asarray(c, float).reshape(len(self.t), -1) for c in cols])
+        import csv
+
+        from .. import files
+        from ..escape import spreadsheet_cell
         buf = _io.StringIO()
-        buf.write(",".join(names) + "\n")
+        csv.writer(buf, lineterminator="\n").writerow([spreadsheet_cell(n) for n in names])
         np.savetxt(buf, table, delimiter=",", fmt="%.17g")
-        import os
-        import tempfile
-        directory = os.path.dirname(os.path.abspath(path))
         try:
-            fd, tmp = tempfile.mkstemp(prefix=".result.", suffix=".csv", dir=directory)
+            files.atomic_write(path, buf.getvalue())   # a link is replaced, never written through
         except OSError as exc:
             raise OSError(exc.errno, f"cannot write {path}: {exc.strerror}", str(path)) \
                 from None
-        try:
-            with os.fdopen(fd, "w") as fh:
-                fh.write(buf.getvalue())
-            os.replace(tmp, path)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-            raise
         return path
 
     def __getitem__(self, name):

@@ -43,7 +43,7 @@ from .schema import (DIRECTIONS, Checker, _suggest, apply_case, apply_override,
 METHODS = ("auto",) + tuple(_METHODS) + ("symbolic",)
 
 #: ``[simulation]`` defaults.
-DEFAULT_SIMULATION = dict(SIMULATE_DEFAULTS)     # one set of defaults (mbdyn.simulate)
+DEFAULT_SIMULATION = dict(SIMULATE_DEFAULTS)     # one set of defaults (mbdyn.integrate.settings)
 SIMULATE_KEYWORDS = ("t_end", "integrator", "method", "rtol", "atol", "dt", "max_step",
                      "output_dt", "progress", "events", "outputs", "points", "max_steps",
                      "max_samples", "max_wall_time")
@@ -57,6 +57,12 @@ def read_document(path):
     such as ``/dev/zero`` would block or never end); the parsed document is then checked
     against the nesting and number limits (``scan_document``).
     """
+    return parse_document(read_bytes(path), str(path))
+
+
+def read_bytes(path):
+    """The bytes of the model file ``path``: a regular file of at most
+    ``limits.MAX_FILE_BYTES`` (errors name the file)."""
     file = str(path)
     try:
         # non-blocking open: a FIFO without a writer must not hang the reader
@@ -84,16 +90,21 @@ def read_document(path):
     if len(data) > limits.MAX_FILE_BYTES:
         raise ModelFileError(file, "", f"grew beyond {limits.MAX_FILE_BYTES} bytes while "
                              "being read; give a finished model file")
-    return parse_document(data, file)
+    return data
+
+
+def decode_text(data, file="<text>"):
+    """The text of a model file's bytes ``data`` (UTF-8); errors name ``file``."""
+    try:
+        return data.decode("utf-8") if isinstance(data, bytes) else data
+    except UnicodeDecodeError as exc:
+        raise ModelFileError(file, "", f"is not UTF-8 text ({exc.reason} at byte "
+                             f"{exc.start}); save it as UTF-8") from None
 
 
 def parse_document(data, file="<text>"):
     """The parsed TOML of ``data`` (bytes or text); errors name ``file``."""
-    try:
-        text = data.decode("utf-8") if isinstance(data, bytes) else data
-    except UnicodeDecodeError as exc:
-        raise ModelFileError(file, "", f"is not UTF-8 text ({exc.reason} at byte "
-                             f"{exc.start}); save it as UTF-8") from None
+    text = decode_text(data, file)
     if "\x00" in text:
         raise ModelFileError(file, f"line {text.count(chr(10), 0, text.index(chr(0))) + 1}",
                              "holds a NUL character; is it a binary file?")
@@ -144,7 +155,7 @@ def _normalise_overrides(overrides):
     return out
 
 
-def load_model(path, case=None, overrides=None, effects=None):
+def load_model(path, case=None, overrides=None, effects=None, *, text=None):
     """Read a model file and return a ready-to-run ``Scene``.
 
     ``case``: the name of a ``[cases.NAME]`` table to apply (default: the file's
@@ -153,14 +164,19 @@ def load_model(path, case=None, overrides=None, effects=None):
     iterable of ``"PATH=VALUE"`` texts as ``mbdyn run --set`` takes them; applied after
     the case.  ``effects``: switches applied after the file's ``[effects]``, as
     ``--effects`` takes them (``"-gravity,-damper"``, a list, or a mapping; see
-    ``mbdyn.effects``).  Raises ``ModelFileError`` (a ``ModelError``) naming file and key.
+    ``mbdyn.effects``).  ``text``: the file's content, already read (a sweep's member
+    carries its model's text, not a file); ``path`` then only names it.  Raises
+    ``ModelFileError`` (a ``ModelError``) naming file and key.
     """
     if not isinstance(path, (str, os.PathLike)):
         raise ModelError(f"load_model: path must be the path of a .toml file, got {path!r}")
     if isinstance(overrides, str):
         raise ModelError("load_model: overrides must be a mapping {\"parameters.k\": 1.0} or "
                          "a list of \"PATH=VALUE\" texts, not one string")
-    doc = read_document(path)
+    if text is not None and len(text) > limits.MAX_FILE_BYTES:
+        raise ModelFileError(path, "", f"is more than a model file may be "
+                             f"({limits.MAX_FILE_BYTES} characters)")
+    doc = read_document(path) if text is None else parse_document(text, str(path))
     checker = Checker(path)
     checker.check_document(doc)
     default_case = doc.get("model", {}).get("default_case")

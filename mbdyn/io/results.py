@@ -1,11 +1,13 @@
 """Results export: the ``--json`` summary, and CSV + JSON metadata files written atomically.
 
-Every file is written to a temporary file in the target directory, flushed to disk and
-then renamed over the final name with ``os.replace`` -- an interrupted run never leaves a
-half-written file behind (either the old file or the complete new one is there).
+Every file is written through ``mbdyn.files``: to a temporary file in the target directory,
+flushed to disk and then renamed over the final name -- an interrupted run never leaves a
+half-written file behind (either the old file or the complete new one is there), and a
+symbolic link at the final name is replaced, never written through.
 """
 from __future__ import annotations
 
+import csv
 import datetime
 import hashlib
 import io
@@ -13,9 +15,11 @@ import json
 import math
 import os
 import re
-import tempfile
 
 import numpy as np
+
+from .. import files
+from ..escape import spreadsheet_cell
 
 AXES = ("x", "y", "z")
 WRENCH = ("Fx", "Fy", "Fz", "Mx", "My", "Mz")
@@ -116,76 +120,17 @@ def columns(scene, result):
                              for c in cols])
 
 
-def _temporary(path):
-    """A new temporary file beside ``path``, named ``.NAME.PID.RANDOM.tmp`` (hidden, and
-    recognisable as this process's); returns ``(fd, tmp_path)``."""
-    directory = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=f".{os.path.basename(path)}.{os.getpid()}.",
-                               suffix=".tmp", dir=directory)
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o666 & ~umask)
-    return fd, tmp
-
-
-def _write_temporary(path, data):
-    """``data`` (text) in a flushed, synced temporary beside ``path``; returns its path."""
-    fd, tmp = _temporary(path)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-    except BaseException:
-        _unlink(tmp)
-        raise
-    return tmp
-
-
-def _unlink(path):
-    try:
-        os.unlink(path)
-    except OSError:
-        pass
-
-
 def atomic_write(path, text):
     """Write ``text`` to ``path`` via a temporary file and ``os.replace``: a reader sees
     the old file or the whole new one, never a part; the temporary is removed on any
     error or interruption (SIGINT, and SIGTERM under the ``mbdyn`` command)."""
-    tmp = _write_temporary(path, text)
-    try:
-        os.replace(tmp, path)
-    except BaseException:
-        _unlink(tmp)
-        raise
+    files.atomic_write(path, text)
 
 
-def remove_stale_temporaries(directory, names):
-    """Remove temporaries ``.NAME.PID.*.tmp`` of ``names`` left in ``directory`` by a
-    process that no longer runs (killed with SIGKILL mid-write)."""
-    try:
-        entries = os.listdir(directory)
-    except OSError:
-        return
-    for entry in entries:
-        for name in names:
-            prefix = f".{name}."
-            if not (entry.startswith(prefix) and entry.endswith(".tmp")):
-                continue
-            pid = entry[len(prefix):].split(".", 1)[0]
-            if pid.isdigit() and int(pid) != os.getpid() and not _running(int(pid)):
-                _unlink(os.path.join(directory, entry))
+remove_stale_temporaries = files.remove_stale_temporaries
 
-
-def _running(pid):
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except OSError:
-        return True
-    return True
+#: a test's hook, called between the CSV's rename and the JSON's (None: nothing)
+_between_renames = None
 
 
 _UNSAFE = re.compile(r"[^A-Za-z0-9_.+-]")
@@ -206,11 +151,13 @@ def write_results(directory, scene, result, status="ok", error=None, extra=None)
     (created if needed); returns the two paths.
 
     The pair is written as one unit: both are first written whole to temporaries; then
-    the old JSON is removed, the CSV renamed into place and the JSON last.  So a JSON
-    beside a CSV always describes it (it also records the CSV's size, row count and
-    SHA-256), and an interruption at any point leaves either the old pair, a CSV with no
-    JSON, or the new pair -- never a JSON of another CSV, never a temporary (but after
-    SIGKILL, whose leftovers the next write removes).
+    the old JSON is removed, the CSV renamed into place and the JSON last, with SIGINT
+    and SIGTERM held (``files.signals_held``): a Ctrl-C or SIGTERM at any point leaves
+    the old pair or the new pair, never a temporary.  Only what cannot be caught (SIGKILL,
+    a power cut) can stop between the renames; it leaves a CSV with no JSON, which a
+    reader recognises as unfinished.  A JSON beside a CSV always describes it (it records
+    the CSV's size, row count and SHA-256: ``verify_results``); the next write removes the
+    temporaries of a killed one.
     """
     os.makedirs(directory, exist_ok=True)
     stem = output_stem(scene)
@@ -219,7 +166,8 @@ def write_results(directory, scene, result, status="ok", error=None, extra=None)
     remove_stale_temporaries(directory, (stem + ".csv", stem + ".json"))
     names, table = columns(scene, result)
     buf = io.StringIO()
-    buf.write(",".join(names) + "\n")
+    # the header is the one text row: quoted as CSV needs, no cell a spreadsheet formula
+    csv.writer(buf, lineterminator="\n").writerow([spreadsheet_cell(n) for n in names])
     np.savetxt(buf, table, delimiter=",", fmt="%.15g")
     csv_text = buf.getvalue()
     csv_bytes = csv_text.encode("utf-8")
@@ -247,14 +195,17 @@ def write_results(directory, scene, result, status="ok", error=None, extra=None)
     json_text = json.dumps(meta, indent=2, default=_jsonable) + "\n"
     temporaries = []
     try:
-        temporaries.append(_write_temporary(csv_path, csv_text))
-        temporaries.append(_write_temporary(json_path, json_text))
-        _unlink(json_path)                 # no old JSON may stand beside the new CSV
-        os.replace(temporaries[0], csv_path)
-        os.replace(temporaries[1], json_path)
+        temporaries.append(files.write_temporary(csv_path, csv_text))
+        temporaries.append(files.write_temporary(json_path, json_text))
+        with files.signals_held():         # a Ctrl-C or SIGTERM acts after both renames
+            files.remove(json_path)        # no old JSON may stand beside the new CSV
+            files.replace(temporaries[0], csv_path)
+            if _between_renames is not None:
+                _between_renames()
+            files.replace(temporaries[1], json_path)
     except BaseException:
         for tmp in temporaries:
-            _unlink(tmp)
+            files.remove(tmp)
         raise
     return csv_path, json_path
 

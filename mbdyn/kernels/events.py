@@ -21,7 +21,7 @@ from .programs import evaluate
 @njit(cache=True, inline="always")
 def crossed(direction, g_old, g_new):
     """Whether a condition going from ``g_old`` to ``g_new`` crosses zero in ``direction``
-    (the same test as ``mbdyn.simulate._crossed``: reaching zero counts, leaving it not)."""
+    (the same test as ``mbdyn.integrate.event_search.crossed``: reaching zero counts, leaving it not)."""
     up = g_old < 0.0 and g_new >= 0.0
     down = g_old > 0.0 and g_new <= 0.0
     if direction > 0:

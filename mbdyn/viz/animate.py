@@ -9,11 +9,9 @@ upwards.
 """
 from __future__ import annotations
 
-import os
-import tempfile
-
 import numpy as np
 
+from .. import files
 from ..errors import ModelError
 from .geometry import bounds, frames, sample_times, up_rotation
 
@@ -47,20 +45,12 @@ def animate(result, out, speed=1.0, fps=30.0, title=None, max_frames=MAX_FRAMES)
     times = sample_times(result, fps, speed, max_frames)
     scenes = frames(result, times)
     title = title or result.model.name
-    directory = os.path.dirname(os.path.abspath(out))
-    fd, tmp = tempfile.mkstemp(prefix=".anim.", suffix=ext, dir=directory)
-    os.close(fd)
-    try:
+    with files.replacing(out) as tmp:     # a link at ``out`` is replaced, not followed
         if ext == ".html":
             from .html import write_html
             write_html(result.model, scenes, tmp, fps=fps, speed=speed, title=title)
         else:
             _write_movie(result.model, scenes, tmp, ext, fps, speed, title)
-        os.replace(tmp, out)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
     return len(scenes)
 
 

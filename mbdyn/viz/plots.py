@@ -8,11 +8,9 @@ is labelled with its unit; series of one unit share an axis; event times are mar
 """
 from __future__ import annotations
 
-import os
-import tempfile
-
 import numpy as np
 
+from .. import files
 from ..errors import ModelError
 
 FORMATS = (".png", ".pdf", ".svg")
@@ -87,32 +85,15 @@ def _expand(names, table):
 
 def _check_path(path, formats=FORMATS, what="picture"):
     """The extension of an output path, checked before any work: a known format, an
-    existing, writable directory."""
-    ext = os.path.splitext(str(path))[1].lower()
-    if ext not in formats:
-        raise ModelError(f"{path}: unknown {what} format {ext or '(none)'!r}; use one of "
-                         f"{', '.join(formats)}")
-    directory = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(directory):
-        raise ModelError(f"{path}: the directory {directory} does not exist")
-    if not os.access(directory, os.W_OK):
-        raise ModelError(f"{path}: cannot write into {directory} (permission denied)")
-    return ext
+    existing, writable directory, not a folder itself (``files.check_target``)."""
+    return files.check_target(path, formats, what)
 
 
 def _save(fig, path):
-    """Write via a temporary file in the same directory and rename: no partial file."""
-    ext = os.path.splitext(str(path))[1].lower()
-    directory = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=".plot.", suffix=ext, dir=directory)
-    os.close(fd)
-    try:
+    """Write via a temporary file in the same directory and rename: no partial file, and
+    a symbolic link at ``path`` replaced, never written through (``files.replacing``)."""
+    with files.replacing(path) as tmp:
         fig.savefig(tmp, dpi=110)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
 
 
 def plot_result(result, series=None, phase=None, out=None, title=None):

@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import files
 from ..errors import ModelError
+
+FORMATS = (".png", ".pdf", ".svg")
 
 
 def _axis(values):
@@ -21,8 +24,10 @@ def _axis(values):
 def plot_sweep(result, quantity, path, axes=None, title=None, ax=None):
     """Plot column ``quantity`` of a ``SweepResult`` over its grid ``axes`` (the override
     paths; default all): one axis a line, two a heat map (NaN cells -- no event, a failed
-    member -- left blank).  Writes ``path`` (PNG) unless ``ax`` is given; returns the
-    matplotlib figure."""
+    member -- left blank).  Writes ``path`` (.png, .pdf, .svg; checked first) unless ``ax``
+    is given; returns the matplotlib figure."""
+    if ax is None:
+        files.check_target(path, FORMATS, "picture")
     if quantity not in result.columns:
         raise ModelError(f"--plot {quantity}: not a column of the table; the columns are: "
                          + ", ".join(result.columns))
@@ -70,7 +75,8 @@ def plot_sweep(result, quantity, path, axes=None, title=None, ax=None):
     ax.set_title(title or quantity)
     if fig is not None:
         fig.tight_layout()
-        fig.savefig(path)
+        with files.replacing(path) as tmp:      # a link at ``path`` is replaced
+            fig.savefig(tmp)
         plt.close(fig)
     return ax.figure
 
