@@ -21,7 +21,7 @@ import sympy
 
 __all__ = ["compact", "compact_matrix", "finish", "finish_matrix", "collect_trig", "operations",
            "operations_after_cse", "tree_size", "expanded_terms", "free_symbols", "diff",
-           "MODES"]
+           "replace_shared", "MODES"]
 
 #: ``"compact"`` (default): expand + Pythagorean reduction; ``"expand"``: expand only;
 #: ``"none"``: the raw expressions of the walk; ``"trigsimp"``: compact, then sympy's
@@ -86,7 +86,26 @@ def operations_after_cse(exprs):
     return sum(sympy.count_ops(v) for _, v in repl) + sum(sympy.count_ops(e) for e in reduced)
 
 
-_SIZE_CACHE = {}
+class _Memo:
+    """A memo keyed by the object itself (its ``id``), never by equality: two equal
+    expressions built separately share a hash, and comparing them walks both trees --
+    exponential for the walk's nested expressions.  Each entry keeps its object alive, so
+    an ``id`` is never reused while its entry exists."""
+
+    def __init__(self, size=200000):
+        self.entries, self.size = {}, size
+
+    def get(self, expr):
+        hit = self.entries.get(id(expr))
+        return None if hit is None else hit[1]
+
+    def put(self, expr, value):
+        if len(self.entries) > self.size:
+            self.entries.clear()
+        self.entries[id(expr)] = (expr, value)
+
+
+_SIZE_CACHE = _Memo()
 
 
 def tree_size(expr):
@@ -98,13 +117,37 @@ def tree_size(expr):
     n = _SIZE_CACHE.get(expr)
     if n is None:
         n = len(expr.args) + sum(tree_size(a) for a in expr.args)
-        if len(_SIZE_CACHE) > 200000:
-            _SIZE_CACHE.clear()
-        _SIZE_CACHE[expr] = n
+        _SIZE_CACHE.put(expr, n)
     return n
 
 
-_TERMS_CACHE = {}
+def replace_shared(expr, mapping):
+    """``expr.xreplace(mapping)`` visiting each shared subexpression once.
+
+    The walk's expressions share their parts (a link's velocity is inside every later
+    link's), so their trees are exponentially larger than the objects that hold them: sympy's
+    ``xreplace`` walks the tree (20 s for a 18-link chain), this walks the objects."""
+    memo = {}
+
+    def visit(e):
+        hit = memo.get(id(e))
+        if hit is not None:
+            return hit[1]
+        if e in mapping:
+            out = mapping[e]
+        elif not e.args:
+            out = e
+        else:
+            args = tuple(visit(a) for a in e.args)
+            out = e.func(*args) if any(a is not b for a, b in zip(args, e.args)) else e
+        memo[id(e)] = (e, out)          # the key object is kept alive with its id
+        return out
+    if isinstance(expr, sympy.MatrixBase):
+        return expr.applyfunc(visit)
+    return visit(expr) if isinstance(expr, sympy.Basic) else expr
+
+
+_TERMS_CACHE = _Memo()
 
 
 def expanded_terms(expr):
@@ -126,9 +169,7 @@ def expanded_terms(expr):
         else:
             n = 1
         n = min(n, 10**9)
-        if len(_TERMS_CACHE) > 200000:
-            _TERMS_CACHE.clear()
-        _TERMS_CACHE[expr] = n
+        _TERMS_CACHE.put(expr, n)
     return n
 
 
@@ -246,7 +287,7 @@ def finish_matrix(M, mode="compact", limit=FINISH_LIMIT, units=()):
 
 
 # ---------------------------------------------------------------------------- fast calculus
-_FS_CACHE = {}
+_FS_CACHE = _Memo()
 
 
 def free_symbols(expr):
@@ -259,9 +300,7 @@ def free_symbols(expr):
     out = _FS_CACHE.get(expr)
     if out is None:
         out = frozenset().union(*[free_symbols(a) for a in expr.args])
-        if len(_FS_CACHE) > 200000:
-            _FS_CACHE.clear()
-        _FS_CACHE[expr] = out
+        _FS_CACHE.put(expr, out)
     return out
 
 
