@@ -116,3 +116,126 @@ def test_derive_in_python_keeps_a_long_chain_and_skips_only_the_slow_count(tmp_p
     assert 0 < d.stats["operations_after_cse"] < 10_000
     with pytest.raises(mb.ModelError, match=r"M and f by jourdain would have"):
         mb.derive(mb.load_model(tmp_path / "c.toml").model, max_nodes=10**6)
+
+
+# -- 1: names that matplotlib reads as math -------------------------------------------------
+#: legal labels that matplotlib would parse as TeX math (an exception) or as markup
+MATH_NAMES = ["cost $\\foo{$", "</b>$x^{$", "$$", "a\\$b$", "50% $ of \\$"]
+
+#: the base model, hanging (so that it has an oscillating mode), named as math; with a case
+MATH_MODEL = model_text(name='"cost $\\\\foo{$"', com='[0, "-l", 0]') + \
+    '\n[cases."x $\\\\foo{$"]\ninitial = { theta = 0.3 }\n'
+
+
+def _ffmpeg():
+    try:
+        import imageio_ffmpeg  # noqa: F401
+        return True
+    except ImportError:
+        return False
+
+
+# id, argv, the file it must write
+MATH_CLI_CASES = [
+    ("plot", ["plot", "{model}", "--out", "{tmp}/p.png"], "p.png"),
+    ("plot-case", ["plot", "{model}", "--case", "x $\\foo{$", "--out", "{tmp}/p.png"],
+     "p.png"),
+    ("plot-phase", ["plot", "{model}", "--phase", "theta,theta_dot", "--out", "{tmp}/p.svg"],
+     "p.svg"),
+    ("run-plot", ["run", "{model}", "--case", "x $\\foo{$", "--plot", "{tmp}/r.pdf"], "r.pdf"),
+    ("animate-gif", ["animate", "{model}", "--case", "x $\\foo{$", "--out", "{tmp}/a.gif",
+                     "--speed", "4", "--fps", "10"], "a.gif"),
+    ("animate-mp4", ["animate", "{model}", "--out", "{tmp}/a.mp4", "--speed", "4", "--fps",
+                     "10"], "a.mp4"),
+    ("modes-animate", ["modes", "{model}", "--animate", "{tmp}/m.gif"], "m.gif"),
+    ("accuracy-plot", ["accuracy", "{model}", "--case", "x $\\foo{$", "--integrators", "RK45",
+                       "--tolerances", "1e-4,1e-6", "--repeats", "1", "--plot",
+                       "{tmp}/w.png"], "w.png"),
+]
+
+
+@pytest.mark.parametrize("case_id, argv, written", MATH_CLI_CASES,
+                         ids=[c[0] for c in MATH_CLI_CASES])
+def test_names_matplotlib_reads_as_math_are_drawn_literally(case_id, argv, written, tmp_path,
+                                                           capsys):
+    pytest.importorskip("matplotlib")
+    if written.endswith(".mp4") and not _ffmpeg():
+        pytest.skip("MP4 needs imageio-ffmpeg")
+    code, out, err = in_process(argv, tmp_path, MATH_MODEL, capsys)
+    clean(err)
+    assert code == 0, err
+    assert (tmp_path / written).stat().st_size > 0
+
+
+def _svg_texts(fig_or_call, path):
+    """The texts of an SVG written with its texts kept as text."""
+    import html
+
+    import matplotlib
+    with matplotlib.rc_context({"svg.fonttype": "none"}):
+        fig_or_call(path)
+    return html.unescape(path.read_text())
+
+
+def _math_named_result():
+    s = mb.System(MATH_NAMES[0], gravity=(0, -9.81, 0))
+    parent = "ground"
+    for k, name in enumerate(MATH_NAMES):
+        s.add_body(name, mass=1.0, com=(0, -0.3, 0))
+        s.add_joint(name + " joint", "revolute", parent=parent, child=name, axis="z",
+                    coordinates=[f"_q{k}"], position=(0, -0.3, 0) if k else (0, 0, 0))
+        parent = name
+    model = s.compile()
+    res = mb.simulate(model, 0.3, q0={"_q0": 1.0}, integrator="rk4", dt=0.01,
+                      events=[mb.Event(MATH_NAMES[1], "_q0 - 0.9")])
+    res.compute_outputs(("reactions", "energy"), {MATH_NAMES[2]: (MATH_NAMES[2], (0, 0, 0))})
+    return res
+
+
+def test_python_labels_reach_a_picture_as_the_text_typed(tmp_path):
+    pytest.importorskip("matplotlib")
+    res = _math_named_result()
+    assert res.events and res.events[0][0] == MATH_NAMES[1]
+    joint = MATH_NAMES[3] + " joint"
+    text = _svg_texts(lambda p: res.plot(series=["_q0", f"reaction_{joint}_Fx",
+                                                 f"point_{MATH_NAMES[2]}"],
+                                         out=p, title=MATH_NAMES[4]),
+                      tmp_path / "p.svg")
+    for literal in (MATH_NAMES[4], MATH_NAMES[1], f"reaction {joint} Fx",
+                    f"{MATH_NAMES[2]} x"):
+        assert literal in text, literal
+    assert "\u200b_q0" in text             # a leading _ would have left the legend
+    text = _svg_texts(lambda p: res.plot(phase="_q0,_q0_dot", out=p), tmp_path / "f.svg")
+    assert f"{MATH_NAMES[0]}: phase portrait" in text
+    res.animate(tmp_path / "a.gif", speed=2.0, fps=10.0, title=MATH_NAMES[1])
+    from mbdyn.viz import snapshot
+    text = _svg_texts(lambda p: snapshot(res, p, title=MATH_NAMES[3]), tmp_path / "s.svg")
+    assert MATH_NAMES[3] in text
+
+
+def test_a_campbell_parameter_named_as_math_labels_its_axis_literally(tmp_path):
+    pytest.importorskip("matplotlib")
+
+    def rotor(k):
+        s = mb.System("r", gravity=(0, 0, 0))
+        s.add_body("b", mass=1.0, com=(0, 0, 0))
+        s.add_joint("x", "prismatic", "ground", "b", axis="x")
+        s.add_force("spring", "joint-spring-damper", joint="x", stiffness=k)
+        return s.compile()
+    cb = mb.campbell(rotor, MATH_NAMES[1], [1.0, 2.0, 3.0], spin_is_parameter=False)
+    text = _svg_texts(lambda p: cb.plot(p), tmp_path / "c.svg")
+    assert MATH_NAMES[1] in text
+
+
+def test_a_sweep_picture_shows_text_values_and_names_literally(tmp_path):
+    pytest.importorskip("matplotlib")
+    from mbdyn.analysis.sweep import SweepResult
+    from mbdyn.viz.sweep_plots import plot_sweep
+    quantity = "max:" + MATH_NAMES[0]
+    rows = [{"parameters.l": v, quantity: float(k), "status": "ok"}
+            for k, v in enumerate(MATH_NAMES[1:4])]
+    result = SweepResult(["parameters.l", quantity, "status"], rows, None, {})
+    text = _svg_texts(lambda p: plot_sweep(result, quantity, p, axes=["parameters.l"]),
+                      tmp_path / "s.svg")
+    for literal in [quantity] + MATH_NAMES[1:4]:
+        assert literal in text, literal

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ModelError
+from ..escape import mathtext
 from .equilibrium import EquilibriumError, equilibrium
 from .linearize import linearize
 from .modes import modes as compute_modes
@@ -103,7 +104,7 @@ class Campbell:
             ax.axvline(v, color="tab:orange", lw=0.8, ls=":")
         for m, v in self.onset:
             ax.axvline(v, color="tab:red", lw=1.2, label=f"instability onset ({v:.4g})")
-        ax.set_xlabel(f"{self.parameter}")
+        ax.set_xlabel(mathtext(self.parameter))
         ax.set_ylabel("damped natural frequency [rad/s]")
         ax.set_ylim(bottom=0)
         ax.set_title("Campbell diagram (^ forward, v backward whirl; colour: damping ratio)",

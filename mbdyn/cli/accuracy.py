@@ -8,6 +8,7 @@ import sys
 from . import SUMMARIES
 from ..analysis.accuracy import DEFAULT_INTEGRATORS, TOLERANCES, accuracy_study
 from ..errors import ModelError
+from ..escape import legend_label, mathtext
 from ..simulate import INTEGRATORS
 from .common import add_model_arguments, load, positive, positive_int
 
@@ -121,13 +122,13 @@ def plot(study, path, title=""):
                 and r.error > 0 and r.error != float("inf")]
         if runs:
             ax.loglog([r.wall_time_s for r in runs], [r.error for r in runs], "o-",
-                      label=name, markersize=4)
+                      label=legend_label(name), markersize=4)
     if study.error_estimate > 0:
         ax.axhline(study.error_estimate, color="gray", linestyle=":",
                    label="reference's error estimate")
     ax.set_xlabel("wall time [s] (median)")
     ax.set_ylabel("max coordinate error over the run")
-    ax.set_title(f"work-precision: {title}, t = 0 .. {study.t_end:g} s")
+    ax.set_title(mathtext(f"work-precision: {title}, t = 0 .. {study.t_end:g} s"))
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()

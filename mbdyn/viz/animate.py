@@ -15,6 +15,7 @@ import tempfile
 import numpy as np
 
 from ..errors import ModelError
+from ..escape import mathtext
 from .geometry import bounds, frames, sample_times
 
 FORMATS = (".gif", ".mp4", ".html")
@@ -120,8 +121,8 @@ def _figure(model, scenes, title, speed):
         ax.set_ylim(c[1] - half, c[1] + half)
         ax.set_zlim(c[2] - half, c[2] + half)
         ax.set_xlabel("[m]")
-        ax.set_title(f"{title}\nt = {sc.t:.3f} s" + (f"  ({speed:g}x)" if speed != 1 else ""),
-                     fontsize=9)
+        pace = f"  ({speed:g}x)" if speed != 1 else ""
+        ax.set_title(f"{mathtext(title)}\nt = {sc.t:.3f} s{pace}", fontsize=9)
         return []
     return fig, draw
 

@@ -14,6 +14,7 @@ import tempfile
 import numpy as np
 
 from ..errors import ModelError
+from ..escape import legend_label, mathtext
 
 FORMATS = (".png", ".pdf", ".svg")
 SERIES_HELP = ("coordinates, speeds, energy_* (kinetic, potential, total, dissipated, work, "
@@ -143,9 +144,9 @@ def plot_result(result, series=None, phase=None, out=None, title=None):
         ax.plot(x, y, lw=1)
         ax.plot(x[0], y[0], "o", color="tab:green", label=f"t = {result.t[0]:g} s")
         ax.plot(x[-1], y[-1], "s", color="tab:red", label=f"t = {result.t[-1]:g} s")
-        ax.set_xlabel(f"{lx} [{ux}]")
-        ax.set_ylabel(f"{ly} [{uy}]")
-        ax.set_title(f"{title}: phase portrait", fontsize=10)
+        ax.set_xlabel(mathtext(f"{lx} [{ux}]"))
+        ax.set_ylabel(mathtext(f"{ly} [{uy}]"))
+        ax.set_title(mathtext(f"{title}: phase portrait"), fontsize=10)
         ax.legend(fontsize=8)
     else:
         if series is None:
@@ -164,18 +165,18 @@ def plot_result(result, series=None, phase=None, out=None, title=None):
                                  figsize=(7.5, 2.2 + 1.6 * len(by_unit)), squeeze=False)
         for ax, (unit, group) in zip(axes[:, 0], by_unit.items()):
             for n in group:
-                ax.plot(result.t, table[n][0], lw=1.2, label=table[n][2])
+                ax.plot(result.t, table[n][0], lw=1.2, label=legend_label(table[n][2]))
             ax.set_ylabel(f"[{unit}]")
             ax.legend(fontsize=8, loc="best")
             ax.grid(alpha=0.3)
             for name, t in result.events:
                 ax.axvline(t, color="tab:red", lw=0.8, ls="--")
         for name, t in result.events:
-            axes[0, 0].annotate(name, (t, 1.0), xycoords=("data", "axes fraction"),
+            axes[0, 0].annotate(mathtext(name), (t, 1.0), xycoords=("data", "axes fraction"),
                                 fontsize=8, color="tab:red", ha="right", va="bottom",
                                 rotation=90)
         axes[-1, 0].set_xlabel("time t [s]")
-        axes[0, 0].set_title(title, fontsize=10)
+        axes[0, 0].set_title(mathtext(title), fontsize=10)
     fig.tight_layout()
     if out is not None:
         _save(fig, out)
