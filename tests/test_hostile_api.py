@@ -213,16 +213,18 @@ def test_python_labels_reach_a_picture_as_the_text_typed(tmp_path):
     assert MATH_NAMES[3] in text
 
 
+def _spring_model(k):
+    """A mass on a spring of stiffness ``k``: a Campbell diagram's model function."""
+    s = mb.System("r", gravity=(0, 0, 0))
+    s.add_body("b", mass=1.0, com=(0, 0, 0))
+    s.add_joint("x", "prismatic", "ground", "b", axis="x")
+    s.add_force("spring", "joint-spring-damper", joint="x", stiffness=k)
+    return s.compile()
+
+
 def test_a_campbell_parameter_named_as_math_labels_its_axis_literally(tmp_path):
     pytest.importorskip("matplotlib")
-
-    def rotor(k):
-        s = mb.System("r", gravity=(0, 0, 0))
-        s.add_body("b", mass=1.0, com=(0, 0, 0))
-        s.add_joint("x", "prismatic", "ground", "b", axis="x")
-        s.add_force("spring", "joint-spring-damper", joint="x", stiffness=k)
-        return s.compile()
-    cb = mb.campbell(rotor, MATH_NAMES[1], [1.0, 2.0, 3.0], spin_is_parameter=False)
+    cb = mb.campbell(_spring_model, MATH_NAMES[1], [1.0, 2.0, 3.0], spin_is_parameter=False)
     text = _svg_texts(lambda p: cb.plot(p), tmp_path / "c.svg")
     assert MATH_NAMES[1] in text
 
@@ -239,3 +241,54 @@ def test_a_sweep_picture_shows_text_values_and_names_literally(tmp_path):
                       tmp_path / "s.svg")
     for literal in [quantity] + MATH_NAMES[1:4]:
         assert literal in text, literal
+
+
+# -- 2: outputs checked before the work -----------------------------------------------------
+class WorkStarted(BaseException):
+    """The command began its work before refusing its output path."""
+
+
+# id, argv, pattern of the refusal
+OUTPUT_CASES = []
+for _command, _argv in (
+        ("plot", ["plot", "{model}", "--out"]),
+        ("run", ["run", "{model}", "--plot"]),
+        ("animate", ["animate", "{model}", "--out"]),
+        ("modes", ["modes", "{model}", "--animate"]),
+        ("campbell", ["campbell", "{model}", "--parameter", "l", "--values", "1:2:100000",
+                      "--plot"]),
+        ("accuracy", ["accuracy", "{model}", "--plot"])):
+    OUTPUT_CASES += [
+        (f"{_command}-format", _argv + ["{tmp}/x.txt"], r"x.txt: unknown (picture|animation) "
+                                                        r"format '.txt'; use one of"),
+        (f"{_command}-folder", _argv + ["{tmp}/nope/x.png" if _command not in (
+            "animate", "modes") else "{tmp}/nope/x.gif"], r"the directory .*nope does not "
+                                                          "exist"),
+        (f"{_command}-directory", _argv + ["{tmp}/d.png" if _command not in (
+            "animate", "modes") else "{tmp}/d.gif"], r"d\.(png|gif): is a directory"),
+    ]
+
+
+@pytest.mark.parametrize("case_id, argv, pattern", OUTPUT_CASES,
+                         ids=[c[0] for c in OUTPUT_CASES])
+def test_an_output_is_checked_before_any_work(case_id, argv, pattern, tmp_path, capsys,
+                                              monkeypatch):
+    (tmp_path / "d.png").mkdir()
+    (tmp_path / "d.gif").mkdir()
+
+    def work(*args, **kwargs):          # every command's work starts by loading the model
+        raise WorkStarted(case_id)
+    monkeypatch.setattr("mbdyn.cli.common.load_model", work)
+    code, out, err = in_process(argv, tmp_path, BASE, capsys)
+    clean(err)
+    assert code == 1, err
+    assert re.search(pattern, err), err
+
+
+def test_campbell_plot_in_python_checks_its_path_and_writes_whole(tmp_path):
+    pytest.importorskip("matplotlib")
+    cb = mb.campbell(_spring_model, "k", [1.0, 2.0], spin_is_parameter=False)
+    with pytest.raises(mb.ModelError, match=r"x.txt: unknown picture format"):
+        cb.plot(tmp_path / "x.txt")
+    cb.plot(tmp_path / "c.png")
+    assert sorted(os.listdir(tmp_path)) == ["c.png"]

@@ -82,7 +82,11 @@ class Campbell:
 
     def plot(self, path=None, orders=(1,)):
         """Frequency against the parameter: whirl by marker (^ forward, v backward),
-        damping ratio by colour, the spin lines; saved to ``path`` when given."""
+        damping ratio by colour, the spin lines; saved to ``path`` (.png, .pdf, .svg) when
+        given, whole or not at all."""
+        from ..viz.plots import _check_path, _save
+        if path is not None:
+            _check_path(path)
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
@@ -117,7 +121,7 @@ class Campbell:
             ax.legend(fontsize=8, loc="upper left")
         fig.tight_layout()
         if path is not None:
-            fig.savefig(path, dpi=120)
+            _save(fig, path)
             plt.close(fig)
         return fig
 

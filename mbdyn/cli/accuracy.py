@@ -55,6 +55,10 @@ def _floats(text, what):
 
 
 def run(args):
+    if args.plot:
+        _require_matplotlib()
+        from ..viz.plots import _check_path
+        _check_path(args.plot)         # before the study: a bad path costs nothing
     scene = load(args)
     t_end = args.t_end if args.t_end is not None else scene.settings.get("t_end")
     if not t_end:
@@ -72,8 +76,6 @@ def run(args):
                              f"{', '.join(INTEGRATORS)}")
     tolerances = _floats(args.tolerances, "tolerances") if args.tolerances else TOLERANCES
     steps = _floats(args.steps, "steps") if args.steps else None
-    if args.plot:
-        _require_matplotlib()
 
     def progress(run):
         if not args.json and sys.stderr.isatty():
@@ -132,5 +134,6 @@ def plot(study, path, title=""):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    from ..viz.plots import _save
+    _save(fig, path)
     plt.close(fig)

@@ -39,6 +39,9 @@ def register(subparsers):
 def run(args):
     from ..analysis.campbell import campbell
     from ..errors import ModelError
+    if args.plot:
+        from ..viz.plots import _check_path
+        _check_path(args.plot)         # before the work: a bad path costs nothing
     scene = load(args)
     try:
         orders = [int(o) for o in names(args.orders)]

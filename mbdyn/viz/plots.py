@@ -93,6 +93,9 @@ def _check_path(path, formats=FORMATS, what="picture"):
     if ext not in formats:
         raise ModelError(f"{path}: unknown {what} format {ext or '(none)'!r}; use one of "
                          f"{', '.join(formats)}")
+    if os.path.isdir(path):
+        raise ModelError(f"{path}: is a directory; give a file name ending in "
+                         f"{', '.join(formats)}")
     directory = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(directory):
         raise ModelError(f"{path}: the directory {directory} does not exist")
