@@ -292,3 +292,83 @@ def test_campbell_plot_in_python_checks_its_path_and_writes_whole(tmp_path):
         cb.plot(tmp_path / "x.txt")
     cb.plot(tmp_path / "c.png")
     assert sorted(os.listdir(tmp_path)) == ["c.png"]
+
+
+# -- 4: effects switched both on and off ----------------------------------------------------
+DAMPER = ('\n[[forces]]\nname = "damper"\nkind = "joint-spring-damper"\njoint = "hinge"\n'
+          "damping = 0.1\n")
+
+# id, the file's tail, argv, exit code, pattern
+EFFECT_FILE_CASES = [
+    ("on-and-off", '[effects]\noff = ["gravity"]\non = ["gravity"]\n', [], 1,
+     r"model.toml: effects: effect 'gravity' is switched both on \(on = \['gravity'\]\) and "
+     r"off \(off = \['gravity'\]\)"),
+    ("false-and-on", '[effects]\ngravity = false\non = ["gravity"]\n', [], 1,
+     r"effect 'gravity' is switched both on .* and off \(gravity = false\)"),
+    ("in-one-case", '[cases.a.effects]\non = ["damper"]\noff = ["damper"]\n',
+     ["--case", "a"], 1, r"effect 'damper' is switched both"),
+    ("flag", "", ["--effects=-damper,+damper"], 1,
+     r"--effects.*effect 'damper' is switched both on \(\+damper\) and off \(-damper\)"),
+    ("off-list-not-a-list", "[effects]\noff = 5\n", [], 1, r"effects.off"),
+    # a case decides what it switches: no contradiction with the file's table
+    ("case-switches-back-on", '[effects]\noff = ["damper"]\ngravity = false\n'
+     '[cases.a.effects]\non = ["damper", "gravity"]\n', ["--case", "a"], 0, r"^$"),
+]
+
+
+@pytest.mark.parametrize("case_id, tail, argv, code, pattern", EFFECT_FILE_CASES,
+                         ids=[c[0] for c in EFFECT_FILE_CASES])
+def test_an_effect_switched_both_ways_is_refused_with_its_name(case_id, tail, argv, code,
+                                                               pattern, tmp_path, capsys):
+    got, out, err = in_process(["info", "{model}"] + argv, tmp_path, BASE + DAMPER + tail,
+                               capsys)
+    clean(err)
+    assert got == code, err
+    assert re.search(pattern, err), err
+
+
+def test_a_case_switches_back_on_what_the_file_switches_off(tmp_path):
+    (tmp_path / "m.toml").write_text(BASE + DAMPER + '[effects]\noff = ["damper"]\n'
+                                     'gravity = false\n[cases.a.effects]\non = ["damper"]\n')
+    assert mb.load_model(tmp_path / "m.toml").model.effects == {
+        "gravity": False, "gyroscopic": True, "damper": False}
+    assert mb.load_model(tmp_path / "m.toml", case="a").model.effects == {
+        "gravity": False, "gyroscopic": True, "damper": True}
+
+
+def _pendulum(name="p"):
+    s = mb.System(name, gravity=(0, -9.81, 0))
+    s.add_body("bob", mass=1.0, com=(0.5, 0, 0))
+    s.add_joint("hinge", "revolute", "ground", "bob", axis="z")
+    return s
+
+
+def _damped():
+    s = _pendulum()
+    s.add_force("damper", "joint-spring-damper", joint="hinge", damping=0.1)
+    return s
+
+
+EFFECT_API_CASES = [
+    ("on-and-off", {"off": ["gravity"], "on": ["gravity"]},
+     r"effect 'gravity' is switched both on \(on = \['gravity'\]\) and off"),
+    ("false-and-on", {"gravity": False, "on": ["gravity"]},
+     r"effect 'gravity' is switched both on .* and off \(gravity = false\)"),
+    ("true-and-off", {"off": "damper", "damper": True}, r"effect 'damper' is switched both"),
+    ("text", "-damper, +damper", r"effect 'damper' is switched both"),
+    ("list", ["-gravity", "gravity"], r"effect 'gravity' is switched both"),
+    ("off-number", {"off": 5}, r"effects: off = 5: give a list of effect names"),
+    ("off-nested", {"off": [["gravity"]]}, r"unknown effect \['gravity'\]"),
+]
+
+
+@pytest.mark.parametrize("case_id, spec, pattern", EFFECT_API_CASES,
+                         ids=[c[0] for c in EFFECT_API_CASES])
+def test_compile_refuses_effects_switched_both_ways(case_id, spec, pattern):
+    with pytest.raises(mb.ModelError, match=pattern):
+        _damped().compile(effects=spec)
+
+
+def test_the_same_switch_twice_is_no_contradiction():
+    model = _damped().compile(effects={"off": ["gravity", "gravity"], "gravity": False})
+    assert model.effects["gravity"] is False

@@ -611,7 +611,7 @@ class _SceneBuilder:
         from ..effects import parse_effects
         known = self.system.effect_names()
         with self.engine(("effects",)):
-            state = parse_effects(self.doc.get("effects"), known, f"{self.file}: effects")
+            state = parse_effects(self.doc.get("effects"), known, where="")
         if self.effects_override is not None:
             try:
                 state = parse_effects(self.effects_override, known, "--effects", base=state)
