@@ -263,6 +263,19 @@ def _unknown_keys(kw, allowed, element, kind):
                          f"known: {', '.join(sorted(allowed))}")
 
 
+def _two_frames(kw, element, what):
+    """``(body_a, body_b)`` of an element between two frames (``body_b`` default the
+    ground): names, and two different ones."""
+    frames = (kw["body_a"], kw.get("body_b", "ground"))
+    for key, frame in zip(("body_a", "body_b"), frames):
+        if not isinstance(frame, str):
+            raise ModelError(f"{element}: {key} must be the name of a body, got {frame!r}")
+    if frames[0] == frames[1]:
+        raise ModelError(f"{element}: body_a and body_b are both {frames[0]!r}; {what} acts "
+                         "between two bodies (or a body and the ground)")
+    return frames
+
+
 def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):
     """Validate and build a ``ForceElement`` (frames are checked against the tree by
     ``System.add_force``)."""
@@ -319,7 +332,7 @@ def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):
             raise ModelError(f"{element}: damping_table must not decrease (a damper's force "
                              "grows with the rate of elongation); a falling segment feeds "
                              "energy in")
-        frames = (kw["body_a"], kw.get("body_b", "ground"))
+        frames = _two_frames(kw, element, "a spring")
     elif kind == "joint-spring-damper":
         _unknown_keys(kw, ("joint", "stiffness", "damping", "rest", "preload", "force_table",
                            "damping_table", "interpolation", "law"), element, kind)
@@ -361,7 +374,7 @@ def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):
             "stiffness": _matrix6(kw["stiffness"], parameters, element, "stiffness"),
             "damping": C,
         }
-        frames = (kw["body_a"], kw.get("body_b", "ground"))
+        frames = _two_frames(kw, element, "a bushing")
     elif kind == "bearing":
         _unknown_keys(kw, ("body", "point", "housing", "center", "axis", "speed", "speeds",
                            "interpolation") + BEARING_COEFFICIENTS, element, kind)
@@ -407,6 +420,14 @@ def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):
             "speeds": None if speeds is None else np.asarray(speeds, float),
         })
         frames = (kw["body"], kw.get("housing", "ground"))
+        for key, frame in zip(("body", "housing"), frames):
+            if not isinstance(frame, str):
+                raise ModelError(f"{element}: {key} must be the name of a body, got "
+                                 f"{frame!r}")
+        if frames[0] in ("ground", frames[1]):
+            raise ModelError(f"{element}: the shaft body is {frames[0]!r} and the housing "
+                             f"{frames[1]!r}; a bearing acts between a shaft body and its "
+                             "housing (another body, or the ground)")
     else:   # contact
         _unknown_keys(kw, ("body", "center", "radius", "shape", "axis", "plane_point",
                            "plane_normal", "stiffness", "exponent", "restitution",

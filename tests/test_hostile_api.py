@@ -372,3 +372,40 @@ def test_compile_refuses_effects_switched_both_ways(case_id, spec, pattern):
 def test_the_same_switch_twice_is_no_contradiction():
     model = _damped().compile(effects={"off": ["gravity", "gravity"], "gravity": False})
     assert model.effects["gravity"] is False
+
+
+# -- 5: an element between a body and itself: the same refusal in Python and in a file -----
+# id, the element's keys (TOML), its keyword arguments, pattern
+SAME_BODY_CASES = [
+    ("spring", 'kind = "spring-damper"\nbody_a = "bob"\nbody_b = "bob"\nstiffness = 10.0',
+     dict(kind="spring-damper", body_a="bob", body_b="bob", stiffness=10.0),
+     r"^force 'e': body_a and body_b are both 'bob'; a spring acts between two bodies \(or "
+     r"a body and the ground\)$"),
+    ("spring-ground", 'kind = "spring-damper"\nbody_a = "ground"\nstiffness = 10.0',
+     dict(kind="spring-damper", body_a="ground", stiffness=10.0),
+     r"body_a and body_b are both 'ground'"),
+    ("bushing", 'kind = "bushing"\nbody_a = "bob"\nbody_b = "bob"\n'
+                'stiffness = [1, 1, 1, 1, 1, 1]',
+     dict(kind="bushing", body_a="bob", body_b="bob", stiffness=[1] * 6),
+     r"body_a and body_b are both 'bob'; a bushing acts between two bodies"),
+    ("bearing", 'kind = "bearing"\nbody = "bob"\nhousing = "bob"\nkxx = 1.0\nkyy = 1.0',
+     dict(kind="bearing", body="bob", housing="bob", kxx=1.0, kyy=1.0),
+     r"the shaft body is 'bob' and the housing 'bob'; a bearing acts between"),
+    ("bearing-ground", 'kind = "bearing"\nbody = "ground"\nkxx = 1.0\nkyy = 1.0',
+     dict(kind="bearing", body="ground", kxx=1.0, kyy=1.0),
+     r"the shaft body is 'ground'"),
+]
+
+
+@pytest.mark.parametrize("case_id, toml, keywords, pattern", SAME_BODY_CASES,
+                         ids=[c[0] for c in SAME_BODY_CASES])
+def test_an_element_between_a_body_and_itself_is_refused_alike(case_id, toml, keywords,
+                                                               pattern, tmp_path):
+    with pytest.raises(mb.ModelError, match=pattern) as python:
+        _pendulum().add_force("e", keywords.pop("kind"), **keywords)
+    path = tmp_path / "m.toml"
+    path.write_text(BASE + f'\n[[forces]]\nname = "e"\n{toml}\n')
+    with pytest.raises(mb.ModelFileError) as file:
+        mb.load_model(path)
+    assert file.value.key == "forces[0]"
+    assert file.value.problem == str(python.value)
