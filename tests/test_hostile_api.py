@@ -409,3 +409,48 @@ def test_an_element_between_a_body_and_itself_is_refused_alike(case_id, toml, ke
         mb.load_model(path)
     assert file.value.key == "forces[0]"
     assert file.value.problem == str(python.value)
+
+
+# -- 6: options at the edge of the floats: named, with the bound, no numpy warning ----------
+# id, argv, pattern
+EDGE_CASES = [
+    ("animate-speed-1e-300", ["animate", "{model}", "--out", "{tmp}/a.gif", "--speed",
+                              "1e-300"],
+     r"speed 1e-300 \(--speed\) at [\d.]+ frames per second \(--fps\) would need 6.67e\+300 "
+     r"frames for the 0.2 s of the run, more than 3000; raise the speed to at least 0.00"),
+    ("animate-speed-denormal", ["animate", "{model}", "--out", "{tmp}/a.gif", "--speed",
+                                "1e-320"], r"\(--speed\).*would need more than 1e308 frames"),
+    ("campbell-log-through-zero", ["campbell", "{model}", "--parameter", "l",
+                                   "--values=-1:1:3log"],
+     r"--values '-1:1:3log': a logarithmic range needs START and STOP of one sign, neither "
+     r"zero \(got -1 and 1\); for a linear range write -1:1:3"),
+    ("campbell-log-from-zero", ["campbell", "{model}", "--parameter", "l", "--values",
+                                "0:1:5log"], r"--values '0:1:5log': a logarithmic range"),
+    ("campbell-inf", ["campbell", "{model}", "--parameter", "l", "--values", "inf:1:3"],
+     r"--values 'inf:1:3': inf is not a finite number"),
+    ("campbell-nan-list", ["campbell", "{model}", "--parameter", "l", "--values", "1,nan"],
+     r"--values '1,nan': nan is not a finite number"),
+    ("campbell-huge", ["campbell", "{model}", "--parameter", "l", "--values", "1:1e200:3"],
+     r"--values '1:1e200:3': 1e\+200 is beyond the range mbdyn accepts"),
+]
+
+
+@pytest.mark.parametrize("case_id, argv, pattern", EDGE_CASES, ids=[c[0] for c in EDGE_CASES])
+def test_an_option_at_the_edge_is_named_with_its_bound(case_id, argv, pattern, tmp_path,
+                                                       capsys):
+    code, out, err = in_process(argv, tmp_path, BASE, capsys)
+    clean(err)
+    assert code == 1, err
+    assert re.search(pattern, err), err
+    assert "warning" not in err and len(err) < 400, err     # no numpy warning, no 300 digits
+
+
+def test_an_animation_at_a_tiny_speed_is_refused_in_python_too(tmp_path):
+    res = mb.simulate(_pendulum().compile(), 0.2, integrator="rk4", dt=0.01)
+    for speed in (1e-300, 1e-320):
+        with pytest.raises(mb.ModelError, match=r"raise the speed to at least"):
+            res.animate(tmp_path / "a.html", speed=speed)
+    from mbdyn.viz.geometry import sample_times
+    with pytest.raises(mb.ModelError, match=r"fps \(--fps\) must be a positive, finite"):
+        sample_times(res, fps="many")
+    assert not os.listdir(tmp_path)
