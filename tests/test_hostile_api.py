@@ -454,3 +454,30 @@ def test_an_animation_at_a_tiny_speed_is_refused_in_python_too(tmp_path):
     with pytest.raises(mb.ModelError, match=r"fps \(--fps\) must be a positive, finite"):
         sample_times(res, fps="many")
     assert not os.listdir(tmp_path)
+
+
+# -- 7: sympy expansion bounded -------------------------------------------------------------
+BIG_POWER = BASE.replace("[parameters]\n", "[parameters]\na = 0.3\nb = 0.3\nc = 0.4\n").replace(
+    'mass = "m"\n', 'mass = "(a+b+c)**1000"\ninertia = [1, 1, 1]\ninertia_about = "origin"\n')
+
+
+@pytest.mark.parametrize("command", ["run", "info", "eom"])
+def test_a_huge_power_in_an_inertia_about_the_origin_is_not_expanded(command, tmp_path,
+                                                                     capsys, time_limit):
+    time_limit(60)                  # it ran past 60 s expanding (a+b+c)**1000
+    code, out, err = in_process([command, "{model}"], tmp_path, BIG_POWER, capsys)
+    clean(err)
+    assert code == 0, err
+    if command == "eom":
+        assert "(a + b + c)**1000" in out
+
+
+def test_an_inertia_about_the_origin_is_still_expanded_when_small(tmp_path):
+    path = tmp_path / "m.toml"
+    path.write_text(BIG_POWER.replace("(a+b+c)**1000", "(a+b)**2"))
+    scene = mb.load_model(path)
+    inertia = scene.model.body("bob").inertia
+    np.testing.assert_allclose(np.diag(inertia), [1.0, 1 - 0.36 * 0.25, 1 - 0.36 * 0.25])
+    path.write_text(BIG_POWER)
+    np.testing.assert_allclose(np.diag(mb.load_model(path).model.body("bob").inertia),
+                               [1.0, 0.75, 0.75])

@@ -822,7 +822,11 @@ def _category(name):
 
 def _inertia_about_com(inertia, mass, com):
     """Inertia about the centre of mass from an inertia about the frame origin
-    (``I_G = I_O - m (|d|^2 E - d d^T)``, ``d`` the centre of mass), kept symbolic."""
+    (``I_G = I_O - m (|d|^2 E - d d^T)``, ``d`` the centre of mass), kept symbolic: each
+    entry expanded unless its expansion would exceed ``limits.MAX_EXPANDED_TERMS`` terms
+    (``(a+b+c)**1000`` has half a million; it stays as written, which is as exact)."""
+    from ..symbolic.simplify import expanded_terms
+
     def sym(v):                   # numbers and sympy objects only -- never text
         return v if isinstance(v, sympy.Basic) else sympy.Float(float(v))
     if not isinstance(inertia[0], list):
@@ -836,7 +840,9 @@ def _inertia_about_com(inertia, mass, com):
     for r in range(3):
         row = []
         for c in range(3):
-            e = sympy.expand(I_G[r, c])
+            e = I_G[r, c]
+            if expanded_terms(e) <= limits.MAX_EXPANDED_TERMS:
+                e = sympy.expand(e)
             row.append(float(e) if not e.free_symbols else e)
         out.append(row)
     return out
