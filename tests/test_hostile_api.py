@@ -481,3 +481,73 @@ def test_an_inertia_about_the_origin_is_still_expanded_when_small(tmp_path):
     path.write_text(BIG_POWER)
     np.testing.assert_allclose(np.diag(mb.load_model(path).model.body("bob").inertia),
                                [1.0, 0.75, 0.75])
+
+
+# -- 9: a Campbell diagram at its maximum says how long it will take ------------------------
+class _Stream:
+    def __init__(self, tty):
+        self.text, self.tty = "", tty
+
+    def isatty(self):
+        return self.tty
+
+    def write(self, s):
+        self.text += s
+
+    def flush(self):
+        pass
+
+
+@pytest.mark.parametrize("tty", [False, True])
+def test_an_estimate_extrapolates_the_first_values_after_the_first(tty):
+    from mbdyn.cli.common import Estimate
+    now = [0.0]
+    stream = _Stream(tty)
+    est = Estimate("values", stream=stream, clock=lambda: now[0])
+    now[0] = 5.0                        # the first value pays for compilation
+    est(1, 100_000)
+    for done in (2, 3, 4):
+        now[0] += 0.5
+        est(done, 100_000)
+    assert "mbdyn: 100000 values will take about 14 h (0.5 s each, timed over 3 of them)" \
+        in stream.text
+    now[0] += 0.5
+    est(5, 100_000)
+    assert ("\rmbdyn: 5 of 100000 values" in stream.text) == tty
+    est.close()
+    assert stream.text.count("will take") == 1
+
+
+def test_a_short_loop_gives_no_estimate():
+    from mbdyn.cli.common import Estimate
+    now = [0.0]
+    stream = _Stream(True)
+    est = Estimate("values", stream=stream, clock=lambda: now[0])
+    for done in range(1, 21):
+        now[0] += 0.1
+        est(done, 20)
+    est.close()
+    assert stream.text == ""
+
+
+def test_campbell_at_its_maximum_says_how_long_before_the_work(tmp_path):
+    """100 000 values (the documented maximum): the estimate comes after a few values; the
+    run is then stopped (SIGTERM), cleanly."""
+    (tmp_path / "model.toml").write_text(BASE)
+    env = dict(os.environ, PYTHONPATH=ROOT)
+    proc = subprocess.Popen([sys.executable, "-m", "mbdyn", "campbell", "model.toml",
+                             "--parameter", "l", "--values", f"0.1:2:{limits.MAX_RANGE_POINTS}"],
+                            cwd=tmp_path, env=env, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, text=True)
+    try:
+        line = proc.stderr.readline()
+        assert re.match(r"mbdyn: 100000 values will take about [\d.]+ (s|min|h|days) "
+                        r"\([\d.e-]+ s each, timed over 3 of them\); Ctrl-C stops", line), line
+        proc.send_signal(signal.SIGTERM)
+        err = proc.stderr.read()
+        assert proc.wait(timeout=60) == 143, err
+        clean(err)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()

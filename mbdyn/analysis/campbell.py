@@ -161,7 +161,7 @@ def _builder(scene, parameter):
 
 
 def campbell(scene, parameter, values, orders=(1,), whirl=(), at="equilibrium",
-             fixed=(), spin_is_parameter=True):
+             fixed=(), spin_is_parameter=True, progress=None):
     """Modes against ``parameter`` over ``values``; see the module docstring.
 
     ``scene``: a model file's scene (``parameter`` is a name in its ``[parameters]``; the
@@ -169,6 +169,8 @@ def campbell(scene, parameter, values, orders=(1,), whirl=(), at="equilibrium",
     ``at``: ``"equilibrium"`` (found again at each value, warm-started) or ``"initial"``
     (the scene's initial configuration).  ``whirl``: lateral coordinate pairs (see
     ``analysis.modes``); ``orders``: the spin lines ``n x`` for critical speeds.
+    ``progress``: a callable ``progress(done, total)`` called after each value (``mbdyn
+    campbell`` passes ``cli.common.Estimate``: the time the diagram will take, on stderr).
     """
     if at not in ("equilibrium", "initial"):
         raise ModelError(f"campbell: at must be 'equilibrium' or 'initial', got {at!r}")
@@ -178,7 +180,7 @@ def campbell(scene, parameter, values, orders=(1,), whirl=(), at="equilibrium",
         raise ModelError("campbell: give at least two finite parameter values")
     guess = None
     rows = []
-    for v in values:
+    for i, v in enumerate(values):
         model, q0, _ = build(v)
         q = q0 if guess is None or at == "initial" else guess
         if at == "equilibrium":
@@ -191,6 +193,8 @@ def campbell(scene, parameter, values, orders=(1,), whirl=(), at="equilibrium",
         guess = q
         sign = np.sign(v) if spin_is_parameter and v != 0 else 1.0
         rows.append(compute_modes(lin, whirl=whirl, spin=sign))
+        if progress is not None:
+            progress(i + 1, len(values))
     n = min(len(r.modes) for r in rows)
     # track: assign the modes of each step to those of the previous by MAC
     order = [list(range(n))]
