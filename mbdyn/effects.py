@@ -26,8 +26,17 @@ def parse_effects(spec, known, where="effects", base=None):
     switches one name both on and off (``off = ["gravity"]`` with ``on = ["gravity"]`` or
     ``gravity = true``; ``"-damper,+damper"``): which one was meant cannot be told.
     """
-    state = {name: True for name in known} if base is None else dict(base)
     at = f"{where}: " if where else ""
+    try:
+        names = tuple(known) if not isinstance(known, str) else None
+    except TypeError:
+        names = None
+    if names is None or not all(isinstance(n, str) for n in names):
+        raise ModelError(f"{at}known must be a list of effect names, got {known!r}")
+    known = names
+    if base is not None and not isinstance(base, dict):
+        raise ModelError(f"{at}base must be a mapping {{name: on}}, got {base!r}")
+    state = {name: True for name in known} if base is None else dict(base)
     if spec is not None and not isinstance(spec, (str, dict, list, tuple, set)):
         raise ModelError(f"{at}give effects as \"-gravity,-damper\", a list of such "
                          f"names or a mapping {{name: on}}, not {spec!r}")

@@ -102,10 +102,22 @@ def parse_orientation(orientation, element):
     if (isinstance(orientation, (tuple, list)) and len(orientation) == 2
             and not np.ndim(orientation[1])):
         axis = parse_axis(orientation[0], element + " orientation")
-        angle = float(orientation[1])
+        try:
+            angle = float(orientation[1])
+        except (TypeError, ValueError):
+            raise ModelError(f"{element}: the angle of orientation (axis, angle) must be a "
+                             f"number, got {orientation[1]!r}") from None
+        if not math.isfinite(angle):
+            raise ModelError(f"{element}: the angle of orientation (axis, angle) must be "
+                             f"finite, got {angle}")
         K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
         return np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K
-    arr = np.asarray(orientation, dtype=float)
+    try:
+        arr = np.asarray(orientation, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(f"{element}: orientation must be a 3x3 rotation matrix, a unit "
+                         f"quaternion (w, x, y, z) or (axis, angle), got {orientation!r}") \
+            from None
     if arr.shape == (4,):
         n = np.linalg.norm(arr)
         if not np.isfinite(n) or abs(n - 1.0) > 1e-6:
@@ -285,6 +297,9 @@ def make_drive(drive, element, parameters=None):
                              "callables (q(t), q'(t), q''(t))")
         return Drive(*(_guarded(f, element, what, callable_=True)
                        for f, what in zip(drive, DRIVE_PARTS)))
+    if isinstance(drive, (bool, str)):
+        raise ModelError(f"{element}: drive must be a sympy expression of mb.t or three "
+                         f"callables (q(t), q'(t), q''(t)), got {drive!r}")
     try:
         expr = sympy.Float(drive) if isinstance(drive, (int, float)) else drive
         expr = substitute(expr, parameters or {})
@@ -377,6 +392,10 @@ def _default_names(name, kind, coordinates, speeds, element):
         qn = tuple(f"{name}_{k}" for k in ("x", "y", "z", "qw", "qx", "qy", "qz"))
     else:
         qn = ()
+    for key, given in (("coordinates", coordinates), ("speeds", speeds)):
+        if given is not None and not isinstance(given, (str, list, tuple)):
+            raise ModelError(f"{element}: {key} must be a name or a list of names, got "
+                             f"{given!r}")
     if coordinates is not None:
         coordinates = (coordinates,) if isinstance(coordinates, str) else tuple(coordinates)
         if len(coordinates) != nq:
@@ -427,7 +446,7 @@ def make_joint(name, kind, parent, child, *, axis=None, position=(0, 0, 0), orie
         orientation = (orientation[0], numeric(orientation[1], parameters, element, "orientation"))
     else:
         orientation = numeric(orientation, parameters, element, "orientation")
-    if kind not in KIND_CODES:
+    if not isinstance(kind, str) or kind not in KIND_CODES:
         raise ModelError(f"{element}: unknown kind {kind!r}; use one of "
                          + ", ".join(repr(k) for k in KIND_CODES))
     if kind in ("revolute", "prismatic"):

@@ -338,6 +338,9 @@ def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):
                            "damping_table", "interpolation", "law"), element, kind)
         if "joint" not in kw:
             raise ModelError(f"{element}: give the joint whose coordinate it acts on")
+        if not isinstance(kw["joint"], str):
+            raise ModelError(f"{element}: joint must be the name of a joint, got "
+                             f"{kw['joint']!r}")
         _check_law(kw, element)
         if all(kw.get(k) is None for k in ("stiffness", "force_table", "damping",
                                             "damping_table", "law")):
@@ -385,6 +388,15 @@ def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):
             raise ModelError(f"{element}: missing stiffness {', '.join(missing)}: a bearing "
                              "needs at least kxx and kyy (kxy, kyx, c.. default to 0)")
         speeds = kw.get("speeds")
+        if speeds is not None:
+            try:
+                speeds = np.asarray(speeds, dtype=float)
+            except (TypeError, ValueError):
+                speeds = None
+            if speeds is None or speeds.ndim != 1:
+                raise ModelError(f"{element}: speeds must be a list of spin speeds (rad/s), "
+                                 f"one per row of the tabulated coefficients, got "
+                                 f"{kw['speeds']!r}")
         coeffs = {}
         for c in BEARING_COEFFICIENTS:
             val = kw.get(c, 0.0)
@@ -468,9 +480,11 @@ def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):
         if params["restitution"] == 0.0:
             raise ModelError(f"{element}: restitution 0 needs infinite damping; give a small "
                              "positive value such as 0.05")
-        params["damping_factor"] = (hunt_crossley_factor(params["restitution"],
-                                                         params["exponent"])
-                                    / params["impact_speed"])
+        try:
+            factor = hunt_crossley_factor(params["restitution"], params["exponent"])
+        except ModelError as exc:
+            raise ModelError(f"{element}: {exc}") from None
+        params["damping_factor"] = factor / params["impact_speed"]
         frames = (kw["body"],)
     return ForceElement(name, kind, tuple(frames), params, symbolic)
 
@@ -499,8 +513,13 @@ def hunt_crossley_factor(restitution, exponent):
         def released(s, y):             # force back to zero: x = 0 or 1 + z x' = 0
             return min(y[0], 1.0 + z * y[1]) if s > 0 else 1.0
         released.terminal, released.direction = True, -1
-        sol = solve_ivp(rhs, (0, 1e3), [0.0, 1.0], events=released, rtol=1e-11, atol=1e-13,
-                        method="DOP853", max_step=0.05)
+        with np.errstate(all="ignore"):
+            sol = solve_ivp(rhs, (0, 1e3), [0.0, 1.0], events=released, rtol=1e-11,
+                            atol=1e-13, method="DOP853", max_step=0.05)
+        if sol.y_events is None or not len(sol.y_events[0]):
+            raise ModelError(f"exponent {exponent:g}: the impact of a Hunt-Crossley contact "
+                             "cannot be computed with it (the force overflows); give a "
+                             "moderate exponent such as 1.5 (Hertz)")
         return -sol.y_events[0][0][1]
     lo, hi = 1e-9, 1.0
     while e_of(hi) > restitution:

@@ -551,3 +551,159 @@ def test_campbell_at_its_maximum_says_how_long_before_the_work(tmp_path):
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+
+
+# -- 3: the Python interface: wrong types, NaN/inf, counts below one -> the package's errors --
+def _model():
+    return _pendulum().compile()
+
+
+def _lin():
+    return mb.linearize(_model(), [0.3], [0.0])
+
+
+def _bearing(**keys):
+    return _pendulum().add_force("bearing", "bearing", body="bob", **keys)
+
+
+# id, call, exception, pattern
+API_CASES = [
+    # force elements
+    ("bearing-speeds-number", lambda: _bearing(kxx=[1.0, 2.0], kyy=1.0, speeds=5),
+     mb.ModelError, r"force 'bearing': speeds must be a list of spin speeds"),
+    ("bearing-speeds-text", lambda: _bearing(kxx=[1.0, 2.0], kyy=1.0, speeds="ab"),
+     mb.ModelError, r"speeds must be a list"),
+    ("joint-spring-joint-list", lambda: _pendulum().add_force(
+        "s", "joint-spring-damper", joint=["hinge"], stiffness=1.0), mb.ModelError,
+     r"force 's': joint must be the name of a joint"),
+    ("spring-body-number", lambda: _pendulum().add_force(
+        "s", "spring-damper", body_a=5, stiffness=1.0), mb.ModelError,
+     r"body_a must be the name of a body"),
+    ("contact-exponent-huge", lambda: _pendulum().add_force(
+        "c", "contact", body="bob", stiffness=1e5, restitution=0.5, exponent=1e308),
+     mb.ModelError, r"force 'c': exponent 1e\+308: the impact .* cannot be computed"),
+    ("effects-off-number", lambda: _pendulum().compile(effects={"off": 5}), mb.ModelError,
+     r"off = 5: give a list of effect names"),
+    ("parse-effects-known", lambda: mb.effects.parse_effects(None, None), mb.ModelError,
+     r"known must be a list of effect names"),
+    # joints
+    ("joint-kind-list", lambda: _second(kind=[]), mb.ModelError, r"unknown kind \[\]"),
+    ("joint-orientation-text", lambda: _second(orientation="abc"), mb.ModelError,
+     r"orientation must be a 3x3 rotation matrix"),
+    ("joint-orientation-angle", lambda: _second(orientation=("z", "right")), mb.ModelError,
+     r"the angle of orientation \(axis, angle\) must be a number"),
+    ("joint-orientation-nan", lambda: _second(orientation=("z", float("nan"))),
+     mb.ModelError, r"must be finite"),
+    ("joint-coordinates-number", lambda: _second(coordinates=5), mb.ModelError,
+     r"coordinates must be a name or a list of names"),
+    ("joint-speeds-number", lambda: _second(speeds=1.5), mb.ModelError,
+     r"speeds must be a name or a list of names"),
+    ("joint-drive-bool", lambda: _second(drive=True), mb.ModelError,
+     r"drive must be a sympy expression of mb.t"),
+    # analysis
+    ("equilibrium-t-inf", lambda: mb.equilibrium(_model(), t=float("inf")), mb.ModelError,
+     r"equilibrium: t must be a finite number, got inf"),
+    ("equilibrium-t-nan", lambda: mb.equilibrium(_model(), t=float("nan")), mb.ModelError,
+     r"equilibrium: t must be a finite number, got nan"),
+    ("equilibrium-t-text", lambda: mb.equilibrium(_model(), t="now"), mb.ModelError,
+     r"t must be a number"),
+    ("equilibrium-u-huge", lambda: mb.equilibrium(_model(), u=[1e308]), mb.ModelError,
+     r"generalized forces .* are not finite at the guess"),
+    ("equilibrium-model-text", lambda: mb.equilibrium("pendulum"), mb.ModelError,
+     r"equilibrium: model must be a compiled Model"),
+    ("equilibrium-tol-zero", lambda: mb.equilibrium(_model(), tol=0), mb.ModelError,
+     r"tol must be > 0"),
+    ("equilibrium-max-iter-zero", lambda: mb.equilibrium(_model(), max_iter=0),
+     mb.ModelError, r"max_iter must be a whole number >= 1"),
+    ("equilibrium-fixed-number", lambda: mb.equilibrium(_model(), fixed=5), mb.ModelError,
+     r"fixed must be a name or a list of names"),
+    ("equilibrium-guess-text", lambda: mb.equilibrium(_model(), q_guess="abc"),
+     mb.ModelError, r"q_guess must be an array of numbers"),
+    ("linearize-step-zero", lambda: mb.linearize(_model(), [0.3], [0.0], step=0),
+     mb.ModelError, r"linearize: step must be > 0"),
+    ("linearize-step-huge", lambda: mb.linearize(_model(), [0.3], [0.0], step=1e300),
+     mb.NonFiniteError, r"accelerations came out non-finite"),
+    ("linearize-t-none", lambda: mb.linearize(_model(), t=None), mb.ModelError,
+     r"linearize: t must be a number"),
+    ("linearize-q0-text", lambda: mb.linearize(_model(), q0=["x"]), mb.ModelError,
+     r"q0 must be an array of numbers"),
+    ("linearize-model-none", lambda: mb.linearize(None), mb.ModelError,
+     r"linearize: model must be a compiled Model"),
+    ("modes-not-a-linearization", lambda: mb.modes(_model()), mb.ModelError,
+     r"modes: give a linearisation"),
+    ("modes-whirl-number", lambda: mb.modes(_lin(), whirl=5), mb.ModelError,
+     r"whirl must be a list of pairs"),
+    ("modes-tolerance-none", lambda: mb.modes(_lin(), rigid_tolerance=None), mb.ModelError,
+     r"rigid_tolerance must be a number"),
+    ("campbell-returns-none", lambda: mb.campbell(lambda v: None, "k", [1.0, 2.0]),
+     mb.ModelError, r"campbell: the function of k returned NoneType at k = 1; it must "
+                    r"return a compiled Model"),
+    ("campbell-values-text", lambda: mb.campbell(_spring_model, "k", "abc"), mb.ModelError,
+     r"campbell: values must be numbers"),
+    ("campbell-orders-number", lambda: mb.campbell(_spring_model, "k", [1, 2], orders=2),
+     mb.ModelError, r"orders must be a list of whole numbers"),
+    ("campbell-orders-zero", lambda: mb.campbell(_spring_model, "k", [1, 2], orders=[0]),
+     mb.ModelError, r"each of orders must be a whole number >= 1"),
+    ("campbell-parameter-number", lambda: mb.campbell(_spring_model, 5, [1, 2]),
+     mb.ModelError, r"parameter must be a name"),
+    ("derive-max-nodes-text", lambda: mb.derive(_model(), max_nodes="many"), mb.ModelError,
+     r"max_nodes must be a whole number"),
+    # helpers
+    ("sphere-mass-text", lambda: mb.inertia.sphere("1", 0.1), mb.ModelError,
+     r"inertia.sphere: mass must be a number"),
+    ("sphere-radius-huge", lambda: mb.inertia.sphere(1.0, 1e300), mb.ModelError,
+     r"inertia.sphere: radius 1e\+300 is beyond the range"),
+    ("disk-axis", lambda: mb.inertia.disk(1.0, 0.1, axis="w"), mb.ModelError,
+     r"inertia.disk: axis must be 'x', 'y' or 'z'"),
+    ("parallel-axis-mass-nan", lambda: mb.inertia.parallel_axis(np.eye(3), float("nan"),
+                                                                (0, 0, 1)),
+     mb.ModelError, r"parallel_axis: mass must be a finite number"),
+    ("parallel-axis-offset-text", lambda: mb.inertia.parallel_axis(np.eye(3), 1.0, "up"),
+     mb.ModelError, r"parallel_axis: give the inertia as a 3x3 tensor"),
+    ("about-com-inertia-nan", lambda: mb.inertia.about_com(np.full((3, 3), np.nan), 1.0,
+                                                           (0, 0, 1)),
+     mb.ModelError, r"about_com: inertia: nan is not a finite number"),
+    ("axis-angle-nan", lambda: mb.rotations.from_axis_angle("z", float("nan")),
+     mb.ModelError, r"from_axis_angle: angle must be a finite number, got nan"),
+    ("euler-number", lambda: mb.rotations.from_euler(5), mb.ModelError,
+     r"from_euler: angles must be 3 finite numbers"),
+    ("to-matrix-text", lambda: mb.rotations.to_matrix("abc"), mb.ModelError,
+     r"to_matrix: 'abc' is not a quaternion"),
+    ("from-matrix-text", lambda: mb.rotations.from_matrix("abc"), mb.ModelError,
+     r"from_matrix: R must be 3 x 3 finite numbers"),
+    ("body-rates-nan", lambda: mb.rotations.body_rates([1, 0, 0, 0], [np.nan, 0, 0]),
+     mb.ModelError, r"body_rates: omega must be 3 finite numbers"),
+    ("load-model-overrides-number", lambda: mb.load_model(
+        os.path.join(ROOT, "models", "top.toml"), overrides=5), mb.ModelError,
+     r"load_model: overrides must be a mapping"),
+    ("plot-series-number", lambda: _run().plot(series=5), mb.ModelError,
+     r"series must be series names"),
+    ("plot-phase-number", lambda: _run().plot(phase=5), mb.ModelError,
+     r"phase must be series names"),
+]
+
+
+def _second(kind="revolute", **keys):
+    s = _pendulum()
+    s.add_body("bob2", mass=1.0, com=(0.5, 0, 0))
+    keys.setdefault("axis", "z" if kind in ("revolute", []) else None)
+    return s.add_joint("j2", kind, "bob", "bob2", **keys)
+
+
+def _run():
+    return mb.simulate(_model(), 0.1, q0=[0.3])
+
+
+@pytest.mark.parametrize("case_id, call, exc, pattern", API_CASES,
+                         ids=[c[0] for c in API_CASES])
+def test_python_interface_gives_the_packages_errors(case_id, call, exc, pattern):
+    with pytest.raises(exc, match=pattern) as info:
+        call()
+    assert type(info.value).__module__.startswith("mbdyn")     # never a raw TypeError
+
+
+def test_parallel_axis_takes_principal_moments_as_a_diagonal():
+    # three moments were broadcast over the rows of the tensor: a silent wrong answer
+    np.testing.assert_array_equal(mb.inertia.parallel_axis([1.0, 2.0, 3.0], 2.0, (0, 0, 1)),
+                                  mb.inertia.parallel_axis(np.diag([1.0, 2.0, 3.0]), 2.0,
+                                                           (0, 0, 1)))

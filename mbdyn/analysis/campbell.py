@@ -17,6 +17,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..escape import mathtext
+from . import arguments
 from .equilibrium import EquilibriumError, equilibrium
 from .linearize import linearize
 from .modes import modes as compute_modes
@@ -150,10 +151,16 @@ def _builder(scene, parameter):
             return sc.model, sc.q0, sc.u0
         return build
     if callable(scene):
+        from ..compile import Model
+
         def build(v):
             out = scene(float(v))
-            if hasattr(out, "model"):
+            if isinstance(getattr(out, "model", None), Model):
                 return out.model, out.q0, out.u0
+            if not isinstance(out, Model):
+                raise ModelError(f"campbell: the function of {parameter} returned "
+                                 f"{type(out).__name__} at {parameter} = {v:g}; it must "
+                                 "return a compiled Model (System.compile()) or a scene")
             return out, out.default_coordinates(), np.zeros(out.nu)
         return build
     raise ModelError("campbell: give a scene (mb.load_model) or a function of the parameter "
@@ -172,10 +179,24 @@ def campbell(scene, parameter, values, orders=(1,), whirl=(), at="equilibrium",
     ``progress``: a callable ``progress(done, total)`` called after each value (``mbdyn
     campbell`` passes ``cli.common.Estimate``: the time the diagram will take, on stderr).
     """
-    if at not in ("equilibrium", "initial"):
+    if not isinstance(at, str) or at not in ("equilibrium", "initial"):
         raise ModelError(f"campbell: at must be 'equilibrium' or 'initial', got {at!r}")
+    if not isinstance(parameter, str):
+        raise ModelError(f"campbell: parameter must be a name, got {parameter!r}")
+    if not isinstance(orders, (list, tuple)):
+        raise ModelError(f"campbell: orders must be a list of whole numbers >= 1, e.g. "
+                         f"(1, 2), got {orders!r}")
+    orders = [arguments.count(o, "campbell", "each of orders") for o in orders]
+    whirl = arguments.pairs(whirl, "campbell", "whirl")
+    fixed = arguments.names(fixed, "campbell", "fixed")
+    if progress is not None and not callable(progress):
+        raise ModelError(f"campbell: progress must be a function (done, total), got "
+                         f"{progress!r}")
     build = _builder(scene, parameter)
-    values = np.asarray(values, dtype=float)
+    try:
+        values = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(f"campbell: values must be numbers, got {values!r}") from None
     if values.ndim != 1 or len(values) < 2 or not np.all(np.isfinite(values)):
         raise ModelError("campbell: give at least two finite parameter values")
     guess = None

@@ -119,8 +119,11 @@ def parse_document(data, file="<text>"):
 
 def _normalise_overrides(overrides):
     """``{path: value}`` or an iterable of ``"PATH=VALUE"`` texts -> [(path, value, origin)]."""
-    if not overrides:
+    if overrides is None or (isinstance(overrides, (dict, list, tuple)) and not overrides):
         return []
+    if not isinstance(overrides, (dict, list, tuple)):
+        raise ModelError(f"load_model: overrides must be a mapping {{\"parameters.k\": 1.0}} "
+                         f"or a list of \"PATH=VALUE\" texts, got {overrides!r}")
     out = []
     if isinstance(overrides, dict):
         for path, value in overrides.items():

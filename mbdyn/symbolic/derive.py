@@ -220,6 +220,10 @@ def derive(model_or_system, method="jourdain", *, frames="own", simplify="compac
         raise ModelError(f"unknown frames {frames!r}; use one of {', '.join(FRAMES)}")
     if simplify not in MODES:
         raise ModelError(f"unknown simplify {simplify!r}; use one of {', '.join(MODES)}")
+    if max_nodes is not None and (isinstance(max_nodes, bool) or not isinstance(
+            max_nodes, int) or max_nodes < 1):
+        raise ModelError(f"derive: max_nodes must be a whole number >= 1 (or None), got "
+                         f"{max_nodes!r}")
     model = _as_model(model_or_system)
     start = time.perf_counter()
     shorter = "" if method == "jourdain" and not solve else \

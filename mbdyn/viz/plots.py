@@ -71,6 +71,16 @@ def series_table(result):
     return table
 
 
+def _names(value, what):
+    """Series names from ``"a,b"`` or a list of names; anything else is refused."""
+    if isinstance(value, str):
+        return [s.strip() for s in value.split(",") if s.strip()]
+    if isinstance(value, (list, tuple)) and all(isinstance(s, str) for s in value):
+        return [s.strip() for s in value]
+    raise ModelError(f"{what} must be series names, \"a,b\" or a list of names (e.g. "
+                     f"theta1,theta1_dot), got {value!r}")
+
+
 def _expand(names, table):
     out = []
     for name in names:
@@ -135,8 +145,7 @@ def plot_result(result, series=None, phase=None, out=None, title=None):
     table = series_table(result)
     title = title or result.model.name
     if phase is not None:
-        if isinstance(phase, str):
-            phase = [p.strip() for p in phase.split(",")]
+        phase = _names(phase, "phase")
         if len(phase) != 2:
             raise ModelError(f"phase {phase!r}: give two series, e.g. theta1,theta1_dot")
         for p in phase:
@@ -156,8 +165,8 @@ def plot_result(result, series=None, phase=None, out=None, title=None):
             series = list(result.model.coordinates)
             if result.energy is not None:
                 series += ["energy_kinetic", "energy_potential", "energy_balance"]
-        elif isinstance(series, str):
-            series = [s.strip() for s in series.split(",") if s.strip()]
+        else:
+            series = _names(series, "series")
         names = _expand(series, table)
         if not names:
             raise ModelError("nothing to plot: give series names")
