@@ -31,6 +31,7 @@ from ..simulate import DEFAULTS as SIMULATE_DEFAULTS
 from ..simulate import FIXED_STEP, INTEGRATORS, Event, Result
 from ..simulate import simulate as _simulate
 from ..events import sympy_condition as _condition
+from ..expressions import expanded_terms
 from .errors import ModelFileError
 from .expressions import ExpressionError, parse, parse_condition, symbol, to_float
 from .schema import (DIRECTIONS, Checker, _suggest, apply_case, apply_override,
@@ -828,8 +829,6 @@ def _inertia_about_com(inertia, mass, com):
     (``I_G = I_O - m (|d|^2 E - d d^T)``, ``d`` the centre of mass), kept symbolic: each
     entry expanded unless its expansion would exceed ``limits.MAX_EXPANDED_TERMS`` terms
     (``(a+b+c)**1000`` has half a million; it stays as written, which is as exact)."""
-    from ..symbolic.simplify import expanded_terms
-
     def sym(v):                   # numbers and sympy objects only -- never text
         return v if isinstance(v, sympy.Basic) else sympy.Float(float(v))
     if not isinstance(inertia[0], list):
