@@ -12,6 +12,8 @@ as the literal text the user typed, never as markup, script or math:
   HTML): ``& < > " '`` as entities.
 * ``mathtext``: text drawn by matplotlib, which reads ``$...$`` as TeX math (an unbalanced
   or unknown command there is an exception): every ``$`` escaped, so no math mode starts.
+  Titles, axis and colour-bar labels, tick labels and annotations go through it; the labels
+  of plotted lines through ``legend_label``, which also keeps a leading ``_`` in the legend.
 * ``spreadsheet_cell``: a text cell of a CSV table; a cell that starts with ``= + - @`` or
   a tab/carriage return is a formula to a spreadsheet (``=HYPERLINK(...)``), so it gets a
   leading apostrophe, as OWASP's CSV-injection advice says.  Numbers are not text cells.
@@ -42,6 +44,13 @@ def markup(text) -> str:
 def mathtext(text) -> str:
     """``text`` for a matplotlib label or title: shown literally, never as TeX math."""
     return str(text).replace("$", r"\$")
+
+
+def legend_label(text) -> str:
+    """``text`` as the label of a plotted line: ``mathtext``, and a leading ``_`` -- which
+    matplotlib's legend reads as "leave this line out" -- behind a zero-width space."""
+    text = mathtext(text)
+    return "\u200b" + text if text.startswith("_") else text
 
 
 FORMULA_STARTS = ("=", "+", "-", "@", "\t", "\r")

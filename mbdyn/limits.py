@@ -35,6 +35,10 @@ MAX_EXPONENT = 1000
 MAX_CONSTANT = 1e300
 #: terms an expression would have once expanded (the symbolic layer expands)
 MAX_EXPANDED_TERMS = 20_000
+#: parse-tree nodes of equations of motion written out (``mbdyn eom``; a shared part
+#: counted where it occurs): a chain's grow by 2 to 5 per link, and printing takes about
+#: 10 us per node -- 2 000 000 is an 11-link planar chain by Jourdain, about 15 s
+MAX_EQUATION_NODES = 2_000_000
 #: characters of a name (element, coordinate, parameter, case)
 MAX_NAME_LENGTH = 100
 

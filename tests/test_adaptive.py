@@ -288,7 +288,7 @@ def test_models_with_function_loads_or_untranslatable_drives_take_scipys_path(pe
 
 @pytest.mark.parametrize("integrator", PAIRS)
 def test_driven_models_run_compiled_and_agree_with_scipy(integrator):
-    """Drives as programs evaluated at each stage time (``mbdyn.programs``): the rotating
+    """Drives as programs evaluated at each stage time (``mbdyn.compiled.programs``): the rotating
     pendulum (two driven joints) and a drive with elementary functions."""
     rot = load_model(MODELS / "rotating_pendulum.toml")
     assert rot.model.driven_joints

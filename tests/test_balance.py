@@ -1,4 +1,4 @@
-"""The energy balance's running Simpson integral (``mbdyn.balance.cumulative_simpson``):
+"""The energy balance's running Simpson integral (``mbdyn.integrate.balance.cumulative_simpson``):
 exact for parabolas on any grid, and the same numbers as scipy's, bit for bit (the run's
 energy columns must not change with the route)."""
 import numpy as np

@@ -1,5 +1,5 @@
 """Event conditions compiled: text and sympy conditions become programs of the stack machine
-(``mbdyn.programs``), evaluated after every step inside the compiled loops.
+(``mbdyn.compiled.programs``), evaluated after every step inside the compiled loops.
 
 Checked against independent routes: numpy's evaluation of the same sympy expression
 (``lambdify``), and the same run with the conditions given as Python functions, which

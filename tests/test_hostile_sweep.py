@@ -392,7 +392,8 @@ def _stop(proc):
 def test_a_second_sweep_on_the_same_table_is_refused(tmp_path, capsys):
     (tmp_path / "model.toml").write_text(BASE)
     table = tmp_path / "s.csv"
-    first = _start_sweep(tmp_path, table)
+    # long enough to be still running however fast the machine (it is stopped below)
+    first = _start_sweep(tmp_path, table, members=20000)
     try:
         code, out, err = run_main(SWEEP + ["--out", str(table)], tmp_path, capsys)
         assert code == 1, err

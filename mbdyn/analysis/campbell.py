@@ -16,6 +16,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ModelError
+from ..escape import mathtext
+from . import arguments
 from .equilibrium import EquilibriumError, equilibrium
 from .linearize import linearize
 from .modes import modes as compute_modes
@@ -81,7 +83,11 @@ class Campbell:
 
     def plot(self, path=None, orders=(1,)):
         """Frequency against the parameter: whirl by marker (^ forward, v backward),
-        damping ratio by colour, the spin lines; saved to ``path`` when given."""
+        damping ratio by colour, the spin lines; saved to ``path`` (.png, .pdf, .svg) when
+        given, whole or not at all."""
+        from ..files import check_target
+        if path is not None:
+            check_target(path, (".png", ".pdf", ".svg"), "picture")
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
@@ -103,7 +109,7 @@ class Campbell:
             ax.axvline(v, color="tab:orange", lw=0.8, ls=":")
         for m, v in self.onset:
             ax.axvline(v, color="tab:red", lw=1.2, label=f"instability onset ({v:.4g})")
-        ax.set_xlabel(f"{self.parameter}")
+        ax.set_xlabel(mathtext(self.parameter))
         ax.set_ylabel("damped natural frequency [rad/s]")
         ax.set_ylim(bottom=0)
         ax.set_title("Campbell diagram (^ forward, v backward whirl; colour: damping ratio)",
@@ -147,10 +153,16 @@ def _builder(scene, parameter):
             return sc.model, sc.q0, sc.u0
         return build
     if callable(scene):
+        from ..compiled.model import Model
+
         def build(v):
             out = scene(float(v))
-            if hasattr(out, "model"):
+            if isinstance(getattr(out, "model", None), Model):
                 return out.model, out.q0, out.u0
+            if not isinstance(out, Model):
+                raise ModelError(f"campbell: the function of {parameter} returned "
+                                 f"{type(out).__name__} at {parameter} = {v:g}; it must "
+                                 "return a compiled Model (System.compile()) or a scene")
             return out, out.default_coordinates(), np.zeros(out.nu)
         return build
     raise ModelError("campbell: give a scene (mb.load_model) or a function of the parameter "
@@ -158,7 +170,7 @@ def _builder(scene, parameter):
 
 
 def campbell(scene, parameter, values, orders=(1,), whirl=(), at="equilibrium",
-             fixed=(), spin_is_parameter=True):
+             fixed=(), spin_is_parameter=True, progress=None):
     """Modes against ``parameter`` over ``values``; see the module docstring.
 
     ``scene``: a model file's scene (``parameter`` is a name in its ``[parameters]``; the
@@ -166,16 +178,32 @@ def campbell(scene, parameter, values, orders=(1,), whirl=(), at="equilibrium",
     ``at``: ``"equilibrium"`` (found again at each value, warm-started) or ``"initial"``
     (the scene's initial configuration).  ``whirl``: lateral coordinate pairs (see
     ``analysis.modes``); ``orders``: the spin lines ``n x`` for critical speeds.
+    ``progress``: a callable ``progress(done, total)`` called after each value (``mbdyn
+    campbell`` passes ``cli.common.Estimate``: the time the diagram will take, on stderr).
     """
-    if at not in ("equilibrium", "initial"):
+    if not isinstance(at, str) or at not in ("equilibrium", "initial"):
         raise ModelError(f"campbell: at must be 'equilibrium' or 'initial', got {at!r}")
+    if not isinstance(parameter, str):
+        raise ModelError(f"campbell: parameter must be a name, got {parameter!r}")
+    if not isinstance(orders, (list, tuple)):
+        raise ModelError(f"campbell: orders must be a list of whole numbers >= 1, e.g. "
+                         f"(1, 2), got {orders!r}")
+    orders = [arguments.count(o, "campbell", "each of orders") for o in orders]
+    whirl = arguments.pairs(whirl, "campbell", "whirl")
+    fixed = arguments.names(fixed, "campbell", "fixed")
+    if progress is not None and not callable(progress):
+        raise ModelError(f"campbell: progress must be a function (done, total), got "
+                         f"{progress!r}")
     build = _builder(scene, parameter)
-    values = np.asarray(values, dtype=float)
+    try:
+        values = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(f"campbell: values must be numbers, got {values!r}") from None
     if values.ndim != 1 or len(values) < 2 or not np.all(np.isfinite(values)):
         raise ModelError("campbell: give at least two finite parameter values")
     guess = None
     rows = []
-    for v in values:
+    for i, v in enumerate(values):
         model, q0, _ = build(v)
         q = q0 if guess is None or at == "initial" else guess
         if at == "equilibrium":
@@ -188,6 +216,8 @@ def campbell(scene, parameter, values, orders=(1,), whirl=(), at="equilibrium",
         guess = q
         sign = np.sign(v) if spin_is_parameter and v != 0 else 1.0
         rows.append(compute_modes(lin, whirl=whirl, spin=sign))
+        if progress is not None:
+            progress(i + 1, len(values))
     n = min(len(r.modes) for r in rows)
     # track: assign the modes of each step to those of the previous by MAC
     order = [list(range(n))]

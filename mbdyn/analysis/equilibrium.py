@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
+from . import arguments
 from .tangent import Tangent
 
 
@@ -76,6 +77,14 @@ def equilibrium(model, q_guess=None, u=None, t=0.0, fixed=(), tol=1e-10, max_ite
     angle of a rotor; their equations are left out too.  ``tol``: on the residual
     ``|f|`` relative to the size of the forces at the guess.
     """
+    where = "equilibrium"
+    model = arguments.model(model, where)
+    t = arguments.number(t, where, "t")
+    tol = arguments.number(tol, where, "tol", positive=True)
+    max_iter = arguments.count(max_iter, where, "max_iter")
+    fixed = arguments.names(fixed, where, "fixed")
+    q_guess = arguments.state(q_guess, where, "q_guess")
+    u = arguments.state(u, where, "u")
     q0 = model.q_vector(dict(q_guess) if isinstance(q_guess, dict) else q_guess).copy()
     u = model.u_vector(dict(u) if isinstance(u, dict) else u).copy()
     if not (np.all(np.isfinite(q0)) and np.all(np.isfinite(u))):
@@ -104,6 +113,10 @@ def equilibrium(model, q_guess=None, u=None, t=0.0, fixed=(), tol=1e-10, max_ite
     r = residual(x)
     scale = max(np.abs(r).max(), np.abs(model.forcing(q0, u, t)).max(),
                 np.abs(np.diag(model.mass_matrix(q0, t))).max() * 9.81, 1e-300)
+    if not (np.all(np.isfinite(r)) and np.isfinite(scale)):
+        raise ModelError(f"equilibrium: the generalized forces of model {model.name!r} are "
+                         f"not finite at the guess (t = {t:g}); check the speeds u and the "
+                         "time t")
     iterations, method, cond = 0, "newton", np.inf
     while np.abs(r).max() > tol * scale and iterations < max_iter:
         iterations += 1

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ModelError, SingularMassMatrixError
+from . import arguments
 from .tangent import Tangent
 
 ROUTES = ("numeric", "symbolic")
@@ -113,9 +114,15 @@ def linearize(model, q0=None, u0=None, t=0.0, route="numeric", step=None):
     ``"symbolic"`` (exact derivatives of the closed-form equations).  Returns a
     ``Linearization``.
     """
-    if route not in ROUTES:
+    where = "linearize"
+    model = arguments.model(model, where)
+    t = arguments.number(t, where, "t")
+    if step is not None:
+        step = arguments.number(step, where, "step", positive=True)
+    if not isinstance(route, str) or route not in ROUTES:
         raise ModelError(f"unknown route {route!r}; use one of {', '.join(ROUTES)}")
-    q0, u0 = _operating_point(model, q0, u0)
+    q0, u0 = _operating_point(model, arguments.state(q0, where, "q0"),
+                              arguments.state(u0, where, "u0"))
     if model.nu == 0:
         raise ModelError(f"model {model.name!r} has no degrees of freedom to linearise")
     tangent = Tangent(model, q0)
@@ -129,6 +136,10 @@ def linearize(model, q0=None, u0=None, t=0.0, route="numeric", step=None):
         error, details = 0.0, {}
     C = -M @ (Gu + B)
     Kt = -M @ (Gx - Gu @ B)
+    if not (np.all(np.isfinite(C)) and np.all(np.isfinite(Kt))):
+        raise ModelError(f"linearize: the derivatives of model {model.name!r} are not finite "
+                         f"at the operating point (t = {t:g}"
+                         + (f", step = {step:g}: try a smaller step)" if step else ")"))
     return _split(C, Kt, M, tangent.names, model, q0, u0, t, route, error, details)
 
 

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
+from . import arguments
 
 
 @dataclass
@@ -136,6 +137,14 @@ def modes(lin, whirl=(), spin=1.0, rigid_tolerance=1e-7):
     (``y x z`` along the spin); ``spin``: the sign (or value) of the spin speed.
     ``rigid_tolerance``: eigenvalues smaller than this times the largest are rigid-body.
     """
+    from .linearize import Linearization
+    if not isinstance(lin, Linearization):
+        raise ModelError(f"modes: give a linearisation (mb.linearize(model, q0, u0)), got "
+                         f"{type(lin).__name__}")
+    whirl = arguments.pairs(whirl, "modes", "whirl")
+    spin = arguments.number(spin, "modes", "spin")
+    rigid_tolerance = arguments.number(rigid_tolerance, "modes", "rigid_tolerance",
+                                       positive=True)
     n = lin.n
     names = lin.names
     index = {nm: k for k, nm in enumerate(names)}

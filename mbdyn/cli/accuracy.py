@@ -8,6 +8,7 @@ import sys
 from . import SUMMARIES
 from ..analysis.accuracy import DEFAULT_INTEGRATORS, TOLERANCES, accuracy_study
 from ..errors import ModelError
+from ..escape import legend_label, mathtext
 from ..files import check_target, replacing
 from ..integrate.settings import INTEGRATORS
 from .common import add_model_arguments, load, positive, positive_int
@@ -55,6 +56,9 @@ def _floats(text, what):
 
 
 def run(args):
+    if args.plot:                      # before the study: a bad path costs nothing
+        check_target(args.plot, (".png", ".pdf", ".svg"), "picture", "--plot")
+        _require_matplotlib()
     scene = load(args)
     t_end = args.t_end if args.t_end is not None else scene.settings.get("t_end")
     if not t_end:
@@ -72,9 +76,6 @@ def run(args):
                              f"{', '.join(INTEGRATORS)}")
     tolerances = _floats(args.tolerances, "tolerances") if args.tolerances else TOLERANCES
     steps = _floats(args.steps, "steps") if args.steps else None
-    if args.plot:
-        check_target(args.plot, (".png", ".pdf", ".svg"), "picture", "--plot")
-        _require_matplotlib()
 
     def progress(run):
         if not args.json and sys.stderr.isatty():
@@ -123,13 +124,13 @@ def plot(study, path, title=""):
                 and r.error > 0 and r.error != float("inf")]
         if runs:
             ax.loglog([r.wall_time_s for r in runs], [r.error for r in runs], "o-",
-                      label=name, markersize=4)
+                      label=legend_label(name), markersize=4)
     if study.error_estimate > 0:
         ax.axhline(study.error_estimate, color="gray", linestyle=":",
                    label="reference's error estimate")
     ax.set_xlabel("wall time [s] (median)")
     ax.set_ylabel("max coordinate error over the run")
-    ax.set_title(f"work-precision: {title}, t = 0 .. {study.t_end:g} s")
+    ax.set_title(mathtext(f"work-precision: {title}, t = 0 .. {study.t_end:g} s"))
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()

@@ -30,10 +30,12 @@ def register(subparsers):
 
 def run(args):
     from ..viz.animate import animate, check_output
+    if args.out:
+        check_output(args.out)         # before the run: a bad request costs nothing
     scene = load(args)
     out = args.out or os.path.splitext(os.path.basename(scene.path))[0] + (
         f"_{scene.case}" if scene.case else "") + ".gif"
-    check_output(out)                      # before the run: a bad request costs nothing
+    check_output(out)
     progress = Progress(scene.settings.get("t_end") or 0.0)
     result = scene.simulate(progress=progress)
     progress.close()

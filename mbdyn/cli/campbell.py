@@ -11,7 +11,7 @@ import json
 import sys
 
 from . import SUMMARIES
-from .common import add_model_arguments, load
+from .common import Estimate, add_model_arguments, load
 from .vibration_args import add_vibration_arguments, names, value_range, whirl_pairs
 
 
@@ -49,9 +49,13 @@ def run(args):
         raise ModelError(f"--orders {args.orders!r}: give integers, e.g. 1,2") from None
     if not orders or any(o < 1 for o in orders):
         raise ModelError(f"--orders {args.orders!r}: give whole numbers >= 1, e.g. 1,2")
-    cb = campbell(scene, args.parameter, value_range(args.values), orders=orders,
-                  whirl=whirl_pairs(args), at=args.at, fixed=names(args.fixed),
-                  spin_is_parameter=not args.not_spin)
+    estimate = Estimate("values")
+    try:
+        cb = campbell(scene, args.parameter, value_range(args.values), orders=orders,
+                      whirl=whirl_pairs(args), at=args.at, fixed=names(args.fixed),
+                      spin_is_parameter=not args.not_spin, progress=estimate)
+    finally:
+        estimate.close()
     if args.plot:
         cb.plot(args.plot, orders=orders)
     if args.json:

@@ -131,3 +131,57 @@ class Progress:
             self.stream.write("\n")
             self.stream.flush()
             self.shown = False
+
+
+def duration(seconds):
+    """A duration, briefly: ``40 s``, ``15 min``, ``2.3 h``, ``4.1 days``."""
+    if seconds < 100:
+        return f"{seconds:.0f} s"
+    if seconds < 6000:
+        return f"{seconds / 60:.0f} min"
+    if seconds < 2 * 86400:
+        return f"{seconds / 3600:.2g} h"
+    return f"{seconds / 86400:.2g} days"
+
+
+class Estimate(Progress):
+    """``progress(done, total)`` for a loop over ``total`` like items (``campbell``'s
+    values).  Once ``sample`` items after the first are done (the first pays for imports
+    and compilation), says on ``stream`` (stderr) how long the whole loop will take,
+    extrapolated from them, if that is ``threshold`` seconds or more; then, on a terminal,
+    shows the count and the time left every ``interval`` seconds."""
+
+    def __init__(self, what, stream=None, sample=3, threshold=10.0, interval=0.5,
+                 force=False, clock=time.monotonic):
+        super().__init__(0.0, stream=stream, delay=0.0, interval=interval, force=force,
+                         clock=clock)
+        self.what, self.sample, self.threshold = what, sample, threshold
+        self.first = None           # (done, time) after the first item
+        self.long = False
+
+    def __call__(self, done, total):
+        now = self.clock()
+        if self.first is None:
+            self.first = (done, now)
+            return
+        d0, t0 = self.first
+        if done - d0 == self.sample and done < total:
+            rate = (now - t0) / (done - d0)
+            whole = (now - self.start) + rate * (total - done)
+            self.long = whole >= self.threshold
+            if self.long:
+                self.stream.write(f"mbdyn: {total} {self.what} will take about "
+                                  f"{duration(whole)} ({rate:.3g} s each, timed over "
+                                  f"{self.sample} of them); Ctrl-C stops\n")
+                self.stream.flush()
+        if not (self.enabled and self.long) or done - d0 < self.sample:
+            return
+        if self.last is not None and now - self.last < self.interval and done < total:
+            return
+        self.last = now
+        left = (now - t0) / (done - d0) * (total - done)
+        self.stream.write(f"\rmbdyn: {done} of {total} {self.what} "
+                          f"({100.0 * done / total:5.1f}%), {duration(now - self.start)} "
+                          f"elapsed, about {duration(left)} left   ")
+        self.stream.flush()
+        self.shown = True

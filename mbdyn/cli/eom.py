@@ -19,6 +19,7 @@ import json
 import sys
 
 from . import SUMMARIES
+from .. import limits
 from ..symbolic.derive import derive
 from ..symbolic.methods import METHODS
 from ..symbolic.simplify import MODES
@@ -74,6 +75,6 @@ def eom(args, out=None):
     out = out if out is not None else sys.stdout
     scene = load(args)
     d = derive(scene.model, args.method, frames=args.frames, simplify=args.simplify,
-               solve=args.solve)
+               solve=args.solve, max_nodes=limits.MAX_EQUATION_NODES)
     out.write(render(d, args.format, args.steps))
     return 0

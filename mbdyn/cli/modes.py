@@ -42,6 +42,9 @@ def run(args):
     from ..analysis.equilibrium import equilibrium
     from ..analysis.linearize import linearize
     from ..analysis.modes import modes
+    if args.animate:
+        from ..viz.animate import check_output
+        check_output(args.animate)     # before the work: a bad path costs nothing
     scene = load(args)
     model = scene.model
     q, u = scene.q0, scene.u0
@@ -49,9 +52,6 @@ def run(args):
     if args.at == "equilibrium":
         eq = equilibrium(model, q, u, t=args.t, fixed=names(args.fixed))
         q = eq.q
-    if args.animate:
-        from ..viz.animate import check_output
-        check_output(args.animate)
     lin = linearize(model, q, u, t=args.t, route=args.route)
     md = modes(lin, whirl=whirl_pairs(args))
     if args.animate:

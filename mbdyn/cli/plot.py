@@ -54,9 +54,9 @@ def plot_run(scene, result, series=None, phase=None, out=None):
 
 def run(args):
     from ..viz.plots import _check_path
-    scene = load(args)
     if args.out:
         _check_path(args.out)          # before the run: a bad path costs nothing
+    scene = load(args)
     progress = Progress(scene.settings.get("t_end") or 0.0)
     result = scene.simulate(progress=progress)
     progress.close()

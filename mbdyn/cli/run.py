@@ -51,14 +51,14 @@ def register(subparsers):
 
 
 def run(args):
+    if args.plot:
+        from ..viz.plots import _check_path
+        _check_path(args.plot)         # before the run: a bad path costs nothing
     scene = load(args, FLAGS)
     if args.dt is not None and scene.settings["integrator"] not in FIXED_STEP:
         warnings.warn(f"--dt is ignored: the adaptive integrator "
                       f"{scene.settings['integrator']} chooses its own steps (choose a "
                       f"fixed-step --integrator: {', '.join(FIXED_STEP)})", ModelWarning)
-    if args.plot:
-        from ..viz.plots import _check_path
-        _check_path(args.plot)
     progress = Progress(scene.settings.get("t_end") or 0.0)
     try:
         result = scene.simulate(progress=progress)

@@ -40,6 +40,14 @@ def _too_many(text, n):
                      "give fewer")
 
 
+def _check_bounds(text, *bounds):
+    for v in bounds:
+        problem = f"{v:g} is not a finite number" if not np.isfinite(v) else \
+            limits.magnitude_problem(v)
+        if problem:
+            raise ModelError(f"--values {text!r}: {problem}")
+
+
 def value_range(text):
     """``START:STOP:N`` (linear), ``START:STOP:Nlog`` (logarithmic) or ``a,b,c``."""
     text = str(text).strip()
@@ -52,15 +60,23 @@ def value_range(text):
                 raise ValueError
             if n > limits.MAX_RANGE_POINTS:
                 return _too_many(text, n)
+            start, stop = float(start), float(stop)
+            _check_bounds(text, start, stop)
             if log:
-                return np.geomspace(float(start), float(stop), n)
-            return np.linspace(float(start), float(stop), n)
+                if not (start * stop > 0):
+                    raise ModelError(f"--values {text!r}: a logarithmic range needs START "
+                                     f"and STOP of one sign, neither zero (got {start:g} and "
+                                     f"{stop:g}); for a linear range write {start:g}:{stop:g}:"
+                                     f"{n}")
+                return np.geomspace(start, stop, n)
+            return np.linspace(start, stop, n)
         values = np.array([float(v) for v in text.split(",")])
     except ModelError:
         raise
     except ValueError:
         raise ModelError(f"--values {text!r}: give START:STOP:N (N >= 2), START:STOP:Nlog "
                          "or a comma-separated list of numbers") from None
-    if len(values) < 2 or not np.all(np.isfinite(values)):
-        raise ModelError(f"--values {text!r}: give at least two finite values")
+    if len(values) < 2:
+        raise ModelError(f"--values {text!r}: give at least two values")
+    _check_bounds(text, *values)
     return values

@@ -263,6 +263,19 @@ def _unknown_keys(kw, allowed, element, kind):
                          f"known: {', '.join(sorted(allowed))}")
 
 
+def _two_frames(kw, element, what):
+    """``(body_a, body_b)`` of an element between two frames (``body_b`` default the
+    ground): names, and two different ones."""
+    frames = (kw["body_a"], kw.get("body_b", "ground"))
+    for key, frame in zip(("body_a", "body_b"), frames):
+        if not isinstance(frame, str):
+            raise ModelError(f"{element}: {key} must be the name of a body, got {frame!r}")
+    if frames[0] == frames[1]:
+        raise ModelError(f"{element}: body_a and body_b are both {frames[0]!r}; {what} acts "
+                         "between two bodies (or a body and the ground)")
+    return frames
+
+
 def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):
     """Validate and build a ``ForceElement`` (frames are checked against the tree by
     ``System.add_force``)."""
@@ -319,12 +332,15 @@ def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):
             raise ModelError(f"{element}: damping_table must not decrease (a damper's force "
                              "grows with the rate of elongation); a falling segment feeds "
                              "energy in")
-        frames = (kw["body_a"], kw.get("body_b", "ground"))
+        frames = _two_frames(kw, element, "a spring")
     elif kind == "joint-spring-damper":
         _unknown_keys(kw, ("joint", "stiffness", "damping", "rest", "preload", "force_table",
                            "damping_table", "interpolation", "law"), element, kind)
         if "joint" not in kw:
             raise ModelError(f"{element}: give the joint whose coordinate it acts on")
+        if not isinstance(kw["joint"], str):
+            raise ModelError(f"{element}: joint must be the name of a joint, got "
+                             f"{kw['joint']!r}")
         _check_law(kw, element)
         if all(kw.get(k) is None for k in ("stiffness", "force_table", "damping",
                                             "damping_table", "law")):
@@ -361,7 +377,7 @@ def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):
             "stiffness": _matrix6(kw["stiffness"], parameters, element, "stiffness"),
             "damping": C,
         }
-        frames = (kw["body_a"], kw.get("body_b", "ground"))
+        frames = _two_frames(kw, element, "a bushing")
     elif kind == "bearing":
         _unknown_keys(kw, ("body", "point", "housing", "center", "axis", "speed", "speeds",
                            "interpolation") + BEARING_COEFFICIENTS, element, kind)
@@ -372,6 +388,15 @@ def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):
             raise ModelError(f"{element}: missing stiffness {', '.join(missing)}: a bearing "
                              "needs at least kxx and kyy (kxy, kyx, c.. default to 0)")
         speeds = kw.get("speeds")
+        if speeds is not None:
+            try:
+                speeds = np.asarray(speeds, dtype=float)
+            except (TypeError, ValueError):
+                speeds = None
+            if speeds is None or speeds.ndim != 1:
+                raise ModelError(f"{element}: speeds must be a list of spin speeds (rad/s), "
+                                 f"one per row of the tabulated coefficients, got "
+                                 f"{kw['speeds']!r}")
         coeffs = {}
         for c in BEARING_COEFFICIENTS:
             val = kw.get(c, 0.0)
@@ -407,6 +432,14 @@ def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):
             "speeds": None if speeds is None else np.asarray(speeds, float),
         })
         frames = (kw["body"], kw.get("housing", "ground"))
+        for key, frame in zip(("body", "housing"), frames):
+            if not isinstance(frame, str):
+                raise ModelError(f"{element}: {key} must be the name of a body, got "
+                                 f"{frame!r}")
+        if frames[0] in ("ground", frames[1]):
+            raise ModelError(f"{element}: the shaft body is {frames[0]!r} and the housing "
+                             f"{frames[1]!r}; a bearing acts between a shaft body and its "
+                             "housing (another body, or the ground)")
     else:   # contact
         _unknown_keys(kw, ("body", "center", "radius", "shape", "axis", "plane_point",
                            "plane_normal", "stiffness", "exponent", "restitution",
@@ -447,9 +480,11 @@ def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):
         if params["restitution"] == 0.0:
             raise ModelError(f"{element}: restitution 0 needs infinite damping; give a small "
                              "positive value such as 0.05")
-        params["damping_factor"] = (hunt_crossley_factor(params["restitution"],
-                                                         params["exponent"])
-                                    / params["impact_speed"])
+        try:
+            factor = hunt_crossley_factor(params["restitution"], params["exponent"])
+        except ModelError as exc:
+            raise ModelError(f"{element}: {exc}") from None
+        params["damping_factor"] = factor / params["impact_speed"]
         frames = (kw["body"],)
     return ForceElement(name, kind, tuple(frames), params, symbolic)
 
@@ -478,8 +513,13 @@ def hunt_crossley_factor(restitution, exponent):
         def released(s, y):             # force back to zero: x = 0 or 1 + z x' = 0
             return min(y[0], 1.0 + z * y[1]) if s > 0 else 1.0
         released.terminal, released.direction = True, -1
-        sol = solve_ivp(rhs, (0, 1e3), [0.0, 1.0], events=released, rtol=1e-11, atol=1e-13,
-                        method="DOP853", max_step=0.05)
+        with np.errstate(all="ignore"):
+            sol = solve_ivp(rhs, (0, 1e3), [0.0, 1.0], events=released, rtol=1e-11,
+                            atol=1e-13, method="DOP853", max_step=0.05)
+        if sol.y_events is None or not len(sol.y_events[0]):
+            raise ModelError(f"exponent {exponent:g}: the impact of a Hunt-Crossley contact "
+                             "cannot be computed with it (the force overflows); give a "
+                             "moderate exponent such as 1.5 (Hertz)")
         return -sol.y_events[0][0][1]
     lo, hi = 1e-9, 1.0
     while e_of(hi) > restitution:

@@ -38,6 +38,9 @@ def make_drive(drive, element, parameters=None):
                              "callables (q(t), q'(t), q''(t))")
         return Drive(*(_guarded(f, element, what, callable_=True)
                        for f, what in zip(drive, DRIVE_PARTS)))
+    if isinstance(drive, (bool, str)):
+        raise ModelError(f"{element}: drive must be a sympy expression of mb.t or three "
+                         f"callables (q(t), q'(t), q''(t)), got {drive!r}")
     try:
         expr = sympy.Float(drive) if isinstance(drive, (int, float)) else drive
         expr = substitute(expr, parameters or {})
@@ -130,6 +133,10 @@ def _default_names(name, kind, coordinates, speeds, element):
         qn = tuple(f"{name}_{k}" for k in ("x", "y", "z", "qw", "qx", "qy", "qz"))
     else:
         qn = ()
+    for key, given in (("coordinates", coordinates), ("speeds", speeds)):
+        if given is not None and not isinstance(given, (str, list, tuple)):
+            raise ModelError(f"{element}: {key} must be a name or a list of names, got "
+                             f"{given!r}")
     if coordinates is not None:
         coordinates = (coordinates,) if isinstance(coordinates, str) else tuple(coordinates)
         if len(coordinates) != nq:
@@ -180,7 +187,7 @@ def make_joint(name, kind, parent, child, *, axis=None, position=(0, 0, 0), orie
         orientation = (orientation[0], numeric(orientation[1], parameters, element, "orientation"))
     else:
         orientation = numeric(orientation, parameters, element, "orientation")
-    if kind not in KIND_CODES:
+    if not isinstance(kind, str) or kind not in KIND_CODES:
         raise ModelError(f"{element}: unknown kind {kind!r}; use one of "
                          + ", ".join(repr(k) for k in KIND_CODES))
     if kind in ("revolute", "prismatic"):

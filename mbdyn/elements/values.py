@@ -95,10 +95,22 @@ def parse_orientation(orientation, element):
     if (isinstance(orientation, (tuple, list)) and len(orientation) == 2
             and not np.ndim(orientation[1])):
         axis = parse_axis(orientation[0], element + " orientation")
-        angle = float(orientation[1])
+        try:
+            angle = float(orientation[1])
+        except (TypeError, ValueError):
+            raise ModelError(f"{element}: the angle of orientation (axis, angle) must be a "
+                             f"number, got {orientation[1]!r}") from None
+        if not math.isfinite(angle):
+            raise ModelError(f"{element}: the angle of orientation (axis, angle) must be "
+                             f"finite, got {angle}")
         K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
         return np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K
-    arr = np.asarray(orientation, dtype=float)
+    try:
+        arr = np.asarray(orientation, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(f"{element}: orientation must be a 3x3 rotation matrix, a unit "
+                         f"quaternion (w, x, y, z) or (axis, angle), got {orientation!r}") \
+            from None
     if arr.shape == (4,):
         n = np.linalg.norm(arr)
         if not np.isfinite(n) or abs(n - 1.0) > 1e-6:

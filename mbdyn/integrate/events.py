@@ -1,5 +1,5 @@
 """Events of a run: zero crossings of a condition, given as text (the model files' syntax,
-read by the safe parser of ``mbdyn.expressions``), as a sympy expression of ``t`` and the
+read by the safe parser of ``mbdyn.elements.expressions``), as a sympy expression of ``t`` and the
 coordinate and speed names, or as a function ``g(t, q, u)``; and the records a run keeps.
 """
 from __future__ import annotations

@@ -33,6 +33,7 @@ from ..integrate.events import Event
 from ..integrate.result import Result
 from ..integrate.simulation import simulate as _simulate
 from ..integrate.events import sympy_condition as _condition
+from ..elements.expressions import expanded_terms
 from .errors import ModelFileError
 from .expressions import ExpressionError, parse, parse_condition, symbol, to_float
 from .schema import (DIRECTIONS, Checker, _suggest, apply_case, apply_override,
@@ -132,8 +133,11 @@ def parse_document(data, file="<text>"):
 
 def _normalise_overrides(overrides):
     """``{path: value}`` or an iterable of ``"PATH=VALUE"`` texts -> [(path, value, origin)]."""
-    if not overrides:
+    if overrides is None or (isinstance(overrides, (dict, list, tuple)) and not overrides):
         return []
+    if not isinstance(overrides, (dict, list, tuple)):
+        raise ModelError(f"load_model: overrides must be a mapping {{\"parameters.k\": 1.0}} "
+                         f"or a list of \"PATH=VALUE\" texts, got {overrides!r}")
     out = []
     if isinstance(overrides, dict):
         for path, value in overrides.items():
@@ -629,7 +633,7 @@ class _SceneBuilder:
         from ..elements.effects import parse_effects
         known = self.system.effect_names()
         with self.engine(("effects",)):
-            state = parse_effects(self.doc.get("effects"), known, f"{self.file}: effects")
+            state = parse_effects(self.doc.get("effects"), known, where="")
         if self.effects_override is not None:
             try:
                 state = parse_effects(self.effects_override, known, "--effects", base=state)
@@ -840,7 +844,9 @@ def _category(name):
 
 def _inertia_about_com(inertia, mass, com):
     """Inertia about the centre of mass from an inertia about the frame origin
-    (``I_G = I_O - m (|d|^2 E - d d^T)``, ``d`` the centre of mass), kept symbolic."""
+    (``I_G = I_O - m (|d|^2 E - d d^T)``, ``d`` the centre of mass), kept symbolic: each
+    entry expanded unless its expansion would exceed ``limits.MAX_EXPANDED_TERMS`` terms
+    (``(a+b+c)**1000`` has half a million; it stays as written, which is as exact)."""
     def sym(v):                   # numbers and sympy objects only -- never text
         return v if isinstance(v, sympy.Basic) else sympy.Float(float(v))
     if not isinstance(inertia[0], list):
@@ -854,7 +860,9 @@ def _inertia_about_com(inertia, mass, com):
     for r in range(3):
         row = []
         for c in range(3):
-            e = sympy.expand(I_G[r, c])
+            e = I_G[r, c]
+            if expanded_terms(e) <= limits.MAX_EXPANDED_TERMS:
+                e = sympy.expand(e)
             row.append(float(e) if not e.free_symbols else e)
         out.append(row)
     return out

@@ -485,8 +485,27 @@ def apply_case(doc, case_name, checker):
         else:
             if key == "parameters":
                 _known_parameters(out, value, checker, lambda k: f"{prefix}.parameters.{k}")
+            if key == "effects":
+                _drop_switches(out.setdefault(key, {}), value)
             _merge_table(out.setdefault(key, {}), value, (key,), f"{prefix}.{key}", checker)
     return out
+
+
+def _drop_switches(base, over):
+    """Remove from the file's ``[effects]`` the names a case's ``[effects]`` switches: the
+    case decides them (it may switch on what the file switches off), and one merged table
+    never says both (``mbdyn.effects`` refuses a table that does)."""
+    def listed(value):                  # the shapes are checked later, with the merge
+        return [value] if isinstance(value, str) else \
+            [n for n in value if isinstance(n, str)] if isinstance(value, list) else []
+    names = set()
+    for key, value in over.items():
+        names.update(listed(value) if key in ("on", "off") else [key])
+    for key in list(base):
+        if key in ("on", "off") and isinstance(base[key], (str, list)):
+            base[key] = [n for n in listed(base[key]) if n not in names]
+        elif key in names:
+            del base[key]
 
 
 def _known_parameters(doc, names, checker, where):

@@ -5,7 +5,7 @@ to Python there.
 A loop takes its events as one tuple ``(ops, consts, starts, direction, terminal, g_prev,
 out_g, stack, any_crossing)``: condition ``k`` is the program ``starts[k] .. starts[k + 1]``,
 ``direction[k]`` +1 (rising), -1 (falling) or 0 (either) and ``terminal[k]`` 0/1 as in
-``mbdyn.events.Event``; ``g_prev`` holds the conditions at the state before the step and is
+``mbdyn.integrate.events.Event``; ``g_prev`` holds the conditions at the state before the step and is
 updated; ``out_g[row]`` receives the conditions after step ``row``.  A loop stops after a
 step where a condition is not finite, or where a terminal one crossed zero (any one with
 ``any_crossing``: the adaptive stretch keeps only its last step's stages, from which Python

@@ -7,7 +7,7 @@ read them from there, so an element enters every route through one place.  A for
 acts on two frames acts on both with opposite signs at the same world point, so it
 transmits no net force or moment to the tree.
 
-Layout (built by ``mbdyn.compile``): ``force_int[e]`` holds ``[kind, frame_a, frame_b,
+Layout (built by ``mbdyn.compiled.force_packing``): ``force_int[e]`` holds ``[kind, frame_a, frame_b,
 offset, table1_offset, table1_mode, table2_offset, table2_mode, index1, index2]`` (frame
 -1 is the ground); the element's numbers start at ``force_data[offset]``.  A table block
 is ``[n, clamp, x(n), y(n), d(n), integral(n)]``: knots, values, slopes at the knots

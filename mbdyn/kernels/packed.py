@@ -49,7 +49,7 @@ def pack(floats, ints):
     ``INTS``) into two buffers.  Returns ``(fbuf, ibuf, table, views)``: ``table`` holds the
     sizes (``SIZES``) and then each array's offset; ``views[name]`` is the array's view.
     The table is also the head of ``ibuf`` (``table`` is that view): ``ibuf`` can stand for
-    the table, so that an entry point takes one array less (``mbdyn.lowlevel``)."""
+    the table, so that an entry point takes one array less (``mbdyn.compiled.lowlevel``)."""
     sizes = {"n": floats["mass"].shape[0], "nu": floats["M"].shape[0],
              "nl": floats["load_force"].shape[0], "nqf": floats["qfull"].shape[0],
              "nuf": floats["ufull"].shape[0], "nanc": ints["anc_idx"].shape[0],

@@ -2,7 +2,7 @@
 ``q''(t)``, and the event conditions ``g(t, q, u)``.
 
 A program is a row range of ``ops`` (``(opcode, argument)`` pairs, postfix order) over the
-constants ``consts``; ``mbdyn.programs`` writes them from sympy expressions.  Opcodes:
+constants ``consts``; ``mbdyn.compiled.programs`` writes them from sympy expressions.  Opcodes:
 ``CONST k`` pushes ``consts[k]``, ``TIME`` pushes ``t``, ``VAR k`` pushes the state's
 ``y[k]`` (``y = [q, u]``), ``ADD n``/``MUL n``/``MIN n``/``MAX n`` replace the top ``n``
 values by their sum/product/least/greatest, ``POW`` replaces ``base, exponent`` by the

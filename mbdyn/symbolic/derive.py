@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 
 import sympy
 
+from .. import limits
 from ..errors import ModelError
 from .methods import FORMULATIONS, METHODS
 from .simplify import (MODES, finish_matrix, operations, operations_after_cse,
@@ -27,7 +28,7 @@ from .simplify import (MODES, finish_matrix, operations, operations_after_cse,
 #: results (M and f together) up to this many nodes get the final tidying (``finish``)
 FINISH_BUDGET = 5000
 from .solve import solve_linear, substitute_rates
-from .walk import FRAMES, Walk
+from .walk import FRAMES, Walk, too_large
 
 
 def _as_model(model_or_system):
@@ -196,7 +197,7 @@ class Derivation:
 
 
 def derive(model_or_system, method="jourdain", *, frames="own", simplify="compact",
-           solve=False, measure=True):
+           solve=False, measure=True, max_nodes=None):
     """Derive the equations of motion of a model in closed form.
 
     ``method``: ``"newton-euler"`` (per-body equations with the joint reactions as unknowns),
@@ -207,7 +208,11 @@ def derive(model_or_system, method="jourdain", *, frames="own", simplify="compac
     ``"none"`` or ``"trigsimp"`` (see ``mbdyn.symbolic.simplify``).  ``solve``: also solve
     for the accelerations (and, for newton-euler, every reaction component) in closed form
     -- practical for a few degrees of freedom.  ``measure``: count the operations of ``M``
-    and ``f`` before and after cse into ``stats`` (slow for very large expressions).
+    and ``f`` before and after cse into ``stats`` (before cse only up to
+    ``limits.MAX_EQUATION_NODES`` parse-tree nodes: counting is as slow as printing).
+    ``max_nodes``: refuse equations (and solutions) whose parse tree, written out, would
+    have more nodes -- a chain's grows by 2 to 5 per link -- as soon as the walk or the
+    formulation shows it (``mbdyn eom`` passes ``limits.MAX_EQUATION_NODES``).
     """
     if method not in METHODS:
         raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")
@@ -215,12 +220,20 @@ def derive(model_or_system, method="jourdain", *, frames="own", simplify="compac
         raise ModelError(f"unknown frames {frames!r}; use one of {', '.join(FRAMES)}")
     if simplify not in MODES:
         raise ModelError(f"unknown simplify {simplify!r}; use one of {', '.join(MODES)}")
+    if max_nodes is not None and (isinstance(max_nodes, bool) or not isinstance(
+            max_nodes, int) or max_nodes < 1):
+        raise ModelError(f"derive: max_nodes must be a whole number >= 1 (or None), got "
+                         f"{max_nodes!r}")
     model = _as_model(model_or_system)
     start = time.perf_counter()
-    walk = Walk(model, frames=frames, simplify=simplify)
+    shorter = "" if method == "jourdain" and not solve else \
+        ", or use the jourdain method without solving (the shortest form)"
+    walk = Walk(model, frames=frames, simplify=simplify, max_nodes=max_nodes)
     t_walk = time.perf_counter()
     eq = FORMULATIONS[method](walk)
     size = sum(tree_size(e) for e in eq.M) + sum(tree_size(e) for e in eq.f)
+    if max_nodes is not None and size > max_nodes:
+        raise too_large(model, f"M and f by {method}", size, max_nodes, shorter)
     if size <= FINISH_BUDGET:               # small results: expand, reduce and tidy them
         M = finish_matrix(eq.M, simplify, units=walk.units)
         f = finish_matrix(eq.f, simplify, units=walk.units)
@@ -246,10 +259,17 @@ def derive(model_or_system, method="jourdain", *, frames="own", simplify="compac
                                                walk.units)
                         comps.append(_quotient(num, den))
                 d.reactions[joint] = comps
+        solved = sum(tree_size(e) for e in d.accelerations.values()) + sum(
+            tree_size(e) for comps in (d.reactions or {}).values() for e in comps)
+        if max_nodes is not None and solved > max_nodes:
+            raise too_large(model, "the solved accelerations" + (" and reactions" if
+                            d.reactions else ""), solved, max_nodes, shorter)
     end = time.perf_counter()
     d.stats = {"derive_s": end - start, "walk_s": t_walk - start, "equations_s": t_eq - t_walk,
                "solve_s": end - t_eq}
     if measure:
-        d.stats["operations"] = operations(M) + operations(f)
+        if sum(tree_size(e) for e in M) + sum(tree_size(e) for e in f) \
+                <= limits.MAX_EQUATION_NODES:
+            d.stats["operations"] = operations(M) + operations(f)
         d.stats["operations_after_cse"] = operations_after_cse([M, f])
     return d

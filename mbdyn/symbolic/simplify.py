@@ -15,13 +15,13 @@ subexpression elimination (``sympy.cse``: then each shared subexpression counts 
 """
 from __future__ import annotations
 
-import math
-
 import sympy
+
+from ..elements.expressions import ObjectMemo, expanded_terms
 
 __all__ = ["compact", "compact_matrix", "finish", "finish_matrix", "collect_trig", "operations",
            "operations_after_cse", "tree_size", "expanded_terms", "free_symbols", "diff",
-           "MODES"]
+           "replace_shared", "MODES"]
 
 #: ``"compact"`` (default): expand + Pythagorean reduction; ``"expand"``: expand only;
 #: ``"none"``: the raw expressions of the walk; ``"trigsimp"``: compact, then sympy's
@@ -86,7 +86,7 @@ def operations_after_cse(exprs):
     return sum(sympy.count_ops(v) for _, v in repl) + sum(sympy.count_ops(e) for e in reduced)
 
 
-_SIZE_CACHE = {}
+_SIZE_CACHE = ObjectMemo()
 
 
 def tree_size(expr):
@@ -98,38 +98,34 @@ def tree_size(expr):
     n = _SIZE_CACHE.get(expr)
     if n is None:
         n = len(expr.args) + sum(tree_size(a) for a in expr.args)
-        if len(_SIZE_CACHE) > 200000:
-            _SIZE_CACHE.clear()
-        _SIZE_CACHE[expr] = n
+        _SIZE_CACHE.put(expr, n)
     return n
 
 
-_TERMS_CACHE = {}
+def replace_shared(expr, mapping):
+    """``expr.xreplace(mapping)`` visiting each shared subexpression once.
 
+    The walk's expressions share their parts (a link's velocity is inside every later
+    link's), so their trees are exponentially larger than the objects that hold them: sympy's
+    ``xreplace`` walks the tree (20 s for a 18-link chain), this walks the objects."""
+    memo = {}
 
-def expanded_terms(expr):
-    """An upper estimate of the number of terms ``expand(expr)`` has (memoised)."""
-    if expr.is_Atom or isinstance(expr, sympy.Function):
-        return 1
-    n = _TERMS_CACHE.get(expr)
-    if n is None:
-        if expr.is_Add:
-            n = sum(expanded_terms(a) for a in expr.args)
-        elif expr.is_Mul:
-            n = 1
-            for a in expr.args:
-                n *= expanded_terms(a)
-        elif expr.is_Pow and expr.exp.is_Integer and expr.exp > 0:
-            b = expanded_terms(expr.base)
-            k = int(expr.exp)
-            n = math.comb(b + k - 1, k) if b > 1 else 1
+    def visit(e):
+        hit = memo.get(id(e))
+        if hit is not None:
+            return hit[1]
+        if e in mapping:
+            out = mapping[e]
+        elif not e.args:
+            out = e
         else:
-            n = 1
-        n = min(n, 10**9)
-        if len(_TERMS_CACHE) > 200000:
-            _TERMS_CACHE.clear()
-        _TERMS_CACHE[expr] = n
-    return n
+            args = tuple(visit(a) for a in e.args)
+            out = e.func(*args) if any(a is not b for a, b in zip(args, e.args)) else e
+        memo[id(e)] = (e, out)          # the key object is kept alive with its id
+        return out
+    if isinstance(expr, sympy.MatrixBase):
+        return expr.applyfunc(visit)
+    return visit(expr) if isinstance(expr, sympy.Basic) else expr
 
 
 def _reduce_unit(expr, unit, k):
@@ -246,7 +242,7 @@ def finish_matrix(M, mode="compact", limit=FINISH_LIMIT, units=()):
 
 
 # ---------------------------------------------------------------------------- fast calculus
-_FS_CACHE = {}
+_FS_CACHE = ObjectMemo()
 
 
 def free_symbols(expr):
@@ -259,9 +255,7 @@ def free_symbols(expr):
     out = _FS_CACHE.get(expr)
     if out is None:
         out = frozenset().union(*[free_symbols(a) for a in expr.args])
-        if len(_FS_CACHE) > 200000:
-            _FS_CACHE.clear()
-        _FS_CACHE[expr] = out
+        _FS_CACHE.put(expr, out)
     return out
 
 

@@ -33,7 +33,8 @@ import numpy as np
 import sympy
 
 from ..errors import ModelError
-from .simplify import compact, compact_matrix, diff, free_symbols
+from .simplify import (compact, compact_matrix, diff, free_symbols, replace_shared,
+                       tree_size)
 from .symbols import (Symbols, axis_vector, canonical, cross, exact, exact_matrix,
                       exact_vector, orientation_matrix, quaternion_matrix,
                       rotation_about_axis, rotation_about_coordinate_axis)
@@ -153,16 +154,28 @@ def quaternion_rates(qj, w):
             (d * w[0] + a * w[1] - b * w[2]) / 2, (-c * w[0] + b * w[1] + a * w[2]) / 2]
 
 
+def too_large(model, what, size, limit, remedy=""):
+    """The error for equations too large to write out (``derive(..., max_nodes=...)``)."""
+    return ModelError(
+        f"model {model.name!r}: {what} would have {size:.3g} parts written out (parse-tree "
+        f"nodes, a shared part counted where it occurs), more than {limit} "
+        "(limits.MAX_EQUATION_NODES; each link of a chain multiplies the size by 2 to 5): "
+        f"derive fewer links{remedy}; in Python, mb.derive keeps the shared form and has no "
+        "such bound")
+
+
 class Walk:
     """The symbolic kinematics and applied loads of a compiled model.
 
     ``frames``: ``"own"`` or ``"inertial"`` (see the module docstring); ``simplify``: one of
     ``mbdyn.symbolic.simplify.MODES``.  ``motions`` lists a ``FrameMotion`` per frame in
     topological order; ``qdot`` maps each coordinate symbol to its rate (the kinematic
-    equations ``q' = N(q) u``).
+    equations ``q' = N(q) u``).  ``max_nodes``: refuse (``too_large``) once the frames'
+    angular velocities and accelerations and centre-of-mass accelerations written out
+    exceed this size (the equations are larger still).
     """
 
-    def __init__(self, model, frames="own", simplify="compact"):
+    def __init__(self, model, frames="own", simplify="compact", max_nodes=None):
         if frames not in FRAMES:
             raise ModelError(f"unknown frames {frames!r}; use one of {', '.join(FRAMES)}")
         self.model = model
@@ -179,7 +192,7 @@ class Walk:
         self.by_name = {}
         self.joint_values = {}
         self.units = []                     # unit quaternions: their squares sum to 1
-        qi = ui = 0
+        qi = ui = walked = 0
         for i, (body, joint) in enumerate(zip(bodies, joints)):
             qj, uj, udj, driven = _joint_values(joint, sym, qi, ui)
             self.joint_values[joint.name] = (qj, uj, udj, driven)
@@ -200,6 +213,11 @@ class Walk:
                 qi += joint.nq
                 ui += joint.nu
             m = self._walk_frame(i, body, joint, qj, uj)
+            if max_nodes is not None:       # stop at the first frame past the bound
+                walked += sum(tree_size(e) for v in (m.omega, m.alpha, m.a_G) for e in v)
+                if walked > max_nodes:
+                    raise too_large(model, f"the kinematics of the frames down to "
+                                    f"{body.name!r} alone", walked, max_nodes)
             self.motions.append(m)
             self.by_name[body.name] = m
             if joint.parent in self.by_name:
@@ -240,7 +258,7 @@ class Walk:
 
     def bias(self, expr):
         """``expr`` at zero speed rates (velocity-product part of an acceleration)."""
-        return expr.xreplace(self.zero_ud)
+        return replace_shared(expr, self.zero_ud)
 
     def _gravity(self):
         m = self.model

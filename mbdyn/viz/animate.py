@@ -13,6 +13,7 @@ import numpy as np
 
 from .. import files
 from ..errors import ModelError
+from ..escape import mathtext
 from .geometry import bounds, frames, sample_times, up_rotation
 
 FORMATS = (".gif", ".mp4", ".html")
@@ -99,8 +100,8 @@ def _figure(model, scenes, title, speed):
         ax.set_ylim(c[1] - half, c[1] + half)
         ax.set_zlim(c[2] - half, c[2] + half)
         ax.set_xlabel("[m]")
-        ax.set_title(f"{title}\nt = {sc.t:.3f} s" + (f"  ({speed:g}x)" if speed != 1 else ""),
-                     fontsize=9)
+        pace = f"  ({speed:g}x)" if speed != 1 else ""
+        ax.set_title(f"{mathtext(title)}\nt = {sc.t:.3f} s{pace}", fontsize=9)
         return []
     return fig, draw
 

@@ -116,14 +116,22 @@ def instant(model, geometry, q, u, t):
 
 
 def sample_times(result, fps=30.0, speed=1.0, max_frames=None):
-    """Frame times: real time (times ``speed``) at ``fps`` frames per second over the run."""
-    if not (fps > 0 and speed > 0):
-        raise ValueError("fps and speed must be positive")
+    """Frame times: real time (times ``speed``) at ``fps`` frames per second over the run;
+    at most ``max_frames`` of them (the message gives the speed that fits)."""
+    for name, value in (("speed", speed), ("fps", fps)):
+        if not isinstance(value, (int, float, np.number)) or not 0 < value < np.inf:
+            raise ModelError(f"{name} (--{name}) must be a positive, finite number, got "
+                             f"{value!r}")
     t0, t1 = float(result.t[0]), float(result.t[-1])
-    n = int(np.floor((t1 - t0) / speed * fps + 1e-9)) + 1
-    if max_frames is not None and n > max_frames:
-        raise ModelError(f"the animation would need {n} frames ((t_end - t0) / speed x fps), "
-                         f"more than {max_frames}; raise the speed or lower the fps")
+    span = (t1 - t0) / speed * fps              # inf for a speed near the smallest float
+    if max_frames is not None and not span + 1 <= max_frames:
+        fitting = (t1 - t0) * fps / max(max_frames - 1, 1)
+        need = f"{span + 1:.3g}" if np.isfinite(span) else "more than 1e308"
+        raise ModelError(f"speed {speed:g} (--speed) at {fps:.3g} frames per second (--fps) "
+                         f"would need {need} frames for the {t1 - t0:g} s of the run, more "
+                         f"than {max_frames}; raise the speed to at least {fitting:.3g} or "
+                         "lower the fps")
+    n = int(np.floor(span + 1e-9)) + 1
     return t0 + np.arange(n) * speed / fps if n > 1 else np.array([t0])
 
 

@@ -12,6 +12,7 @@ import numpy as np
 
 from .. import files
 from ..errors import ModelError
+from ..escape import legend_label, mathtext
 
 FORMATS = (".png", ".pdf", ".svg")
 SERIES_HELP = ("coordinates, speeds, energy_* (kinetic, potential, total, dissipated, work, "
@@ -68,6 +69,16 @@ def series_table(result):
     return table
 
 
+def _names(value, what):
+    """Series names from ``"a,b"`` or a list of names; anything else is refused."""
+    if isinstance(value, str):
+        return [s.strip() for s in value.split(",") if s.strip()]
+    if isinstance(value, (list, tuple)) and all(isinstance(s, str) for s in value):
+        return [s.strip() for s in value]
+    raise ModelError(f"{what} must be series names, \"a,b\" or a list of names (e.g. "
+                     f"theta1,theta1_dot), got {value!r}")
+
+
 def _expand(names, table):
     out = []
     for name in names:
@@ -112,8 +123,7 @@ def plot_result(result, series=None, phase=None, out=None, title=None):
     table = series_table(result)
     title = title or result.model.name
     if phase is not None:
-        if isinstance(phase, str):
-            phase = [p.strip() for p in phase.split(",")]
+        phase = _names(phase, "phase")
         if len(phase) != 2:
             raise ModelError(f"phase {phase!r}: give two series, e.g. theta1,theta1_dot")
         for p in phase:
@@ -124,17 +134,17 @@ def plot_result(result, series=None, phase=None, out=None, title=None):
         ax.plot(x, y, lw=1)
         ax.plot(x[0], y[0], "o", color="tab:green", label=f"t = {result.t[0]:g} s")
         ax.plot(x[-1], y[-1], "s", color="tab:red", label=f"t = {result.t[-1]:g} s")
-        ax.set_xlabel(f"{lx} [{ux}]")
-        ax.set_ylabel(f"{ly} [{uy}]")
-        ax.set_title(f"{title}: phase portrait", fontsize=10)
+        ax.set_xlabel(mathtext(f"{lx} [{ux}]"))
+        ax.set_ylabel(mathtext(f"{ly} [{uy}]"))
+        ax.set_title(mathtext(f"{title}: phase portrait"), fontsize=10)
         ax.legend(fontsize=8)
     else:
         if series is None:
             series = list(result.model.coordinates)
             if result.energy is not None:
                 series += ["energy_kinetic", "energy_potential", "energy_balance"]
-        elif isinstance(series, str):
-            series = [s.strip() for s in series.split(",") if s.strip()]
+        else:
+            series = _names(series, "series")
         names = _expand(series, table)
         if not names:
             raise ModelError("nothing to plot: give series names")
@@ -145,18 +155,18 @@ def plot_result(result, series=None, phase=None, out=None, title=None):
                                  figsize=(7.5, 2.2 + 1.6 * len(by_unit)), squeeze=False)
         for ax, (unit, group) in zip(axes[:, 0], by_unit.items()):
             for n in group:
-                ax.plot(result.t, table[n][0], lw=1.2, label=table[n][2])
+                ax.plot(result.t, table[n][0], lw=1.2, label=legend_label(table[n][2]))
             ax.set_ylabel(f"[{unit}]")
             ax.legend(fontsize=8, loc="best")
             ax.grid(alpha=0.3)
             for name, t in result.events:
                 ax.axvline(t, color="tab:red", lw=0.8, ls="--")
         for name, t in result.events:
-            axes[0, 0].annotate(name, (t, 1.0), xycoords=("data", "axes fraction"),
+            axes[0, 0].annotate(mathtext(name), (t, 1.0), xycoords=("data", "axes fraction"),
                                 fontsize=8, color="tab:red", ha="right", va="bottom",
                                 rotation=90)
         axes[-1, 0].set_xlabel("time t [s]")
-        axes[0, 0].set_title(title, fontsize=10)
+        axes[0, 0].set_title(mathtext(title), fontsize=10)
     fig.tight_layout()
     if out is not None:
         _save(fig, out)

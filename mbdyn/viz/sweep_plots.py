@@ -6,6 +6,7 @@ import numpy as np
 
 from .. import files
 from ..errors import ModelError
+from ..escape import mathtext
 
 FORMATS = (".png", ".pdf", ".svg")
 
@@ -18,7 +19,7 @@ def _axis(values):
         pos = np.array([float(v) for v in distinct])
         return distinct, pos, None
     except (TypeError, ValueError):
-        return distinct, np.arange(len(distinct), dtype=float), [str(v) for v in distinct]
+        return distinct, np.arange(len(distinct), dtype=float), [mathtext(v) for v in distinct]
 
 
 def plot_sweep(result, quantity, path, axes=None, title=None, ax=None):
@@ -50,8 +51,8 @@ def plot_sweep(result, quantity, path, axes=None, title=None, ax=None):
         x = np.array([pos[index[r[axes[0]]]] for r in rows])
         order = np.argsort(x, kind="stable")
         ax.plot(x[order], z[order], "o-")
-        ax.set_xlabel(axes[0])
-        ax.set_ylabel(quantity)
+        ax.set_xlabel(mathtext(axes[0]))
+        ax.set_ylabel(mathtext(quantity))
         if labels:
             ax.set_xticks(pos, labels)
         ax.grid(True, alpha=0.3)
@@ -65,14 +66,14 @@ def plot_sweep(result, quantity, path, axes=None, title=None, ax=None):
             grid[yi[r[axes[1]]], xi[r[axes[0]]]] = val
         mesh = ax.pcolormesh(_edges(xpos), _edges(ypos), np.ma.masked_invalid(grid),
                              shading="flat", cmap="viridis")
-        (ax.figure.colorbar(mesh, ax=ax)).set_label(quantity)
-        ax.set_xlabel(axes[0])
-        ax.set_ylabel(axes[1])
+        (ax.figure.colorbar(mesh, ax=ax)).set_label(mathtext(quantity))
+        ax.set_xlabel(mathtext(axes[0]))
+        ax.set_ylabel(mathtext(axes[1]))
         if xl:
             ax.set_xticks(xpos, xl)
         if yl:
             ax.set_yticks(ypos, yl)
-    ax.set_title(title or quantity)
+    ax.set_title(mathtext(title or quantity))
     if fig is not None:
         fig.tight_layout()
         with files.replacing(path) as tmp:      # a link at ``path`` is replaced
