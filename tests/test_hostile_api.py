@@ -707,3 +707,109 @@ def test_parallel_axis_takes_principal_moments_as_a_diagonal():
     np.testing.assert_array_equal(mb.inertia.parallel_axis([1.0, 2.0, 3.0], 2.0, (0, 0, 1)),
                                   mb.inertia.parallel_axis(np.diag([1.0, 2.0, 3.0]), 2.0,
                                                            (0, 0, 1)))
+
+
+# --- issue 29: the core Python interface (System, Model, simulate, Result) --------------
+def _pendulum_model():
+    s = mb.System("core", gravity=(0, -9.81, 0))
+    s.add_body("b", mass=1.0, com=(0, -1, 0))
+    s.add_joint("j", "revolute", parent="ground", child="b", axis="z")
+    return s, s.compile()
+
+
+CORE_CASES = [
+    ("system-parameters", lambda s, m: mb.System("x", parameters=5), r"must be a mapping"),
+    ("parameter-nan", lambda s, m: mb.System("x", parameters={"a": float("nan")}),
+     r"parameter 'a' is nan"),
+    ("parameter-huge", lambda s, m: mb.System("x", parameters={"a": 1e300}), r"beyond"),
+    ("symbols-number", lambda s, m: mb.System("x", parameters={"a": 1}).symbols(5),
+     r"symbols takes parameter names"),
+    ("origin-com-short", lambda s, m: mb.System("y").add_body(
+        "b", mass=1, com=(0, 0), inertia=(1, 1, 1), inertia_about="origin"), r"com must be"),
+    ("origin-text", lambda s, m: mb.System("y").add_body(
+        "b", mass=1, com=("a", 0, 0), inertia=(1, 1, 1), inertia_about="origin"),
+     r"numbers or sympy expressions"),
+    ("load-name-list", lambda s, m: s.add_load([1], "b", force=(0, 0, 1)), r"must be a string"),
+    ("joint-unknown", lambda s, m: m.joint("zz"), r"unknown joint 'zz'"),
+    ("coordinate-unhashable", lambda s, m: m.coordinate_index([]), r"unknown coordinate"),
+    ("forcing-nan", lambda s, m: m.forcing([np.nan], [0]), r"non-finite values in j"),
+    ("momentum-nan", lambda s, m: m.momentum([np.nan], [0]), r"non-finite values in j"),
+    ("u_dot-text", lambda s, m: m.inverse_dynamics([0], [0], "abc"), r"u_dot must be"),
+    ("y-text", lambda s, m: m.state_derivative(0, "abc"), r"the state y must be"),
+    ("points-none", lambda s, m: m.point_positions([0], None), r"points must be a list"),
+    ("simulate-number", lambda s, m: mb.simulate(5, 1.0), r"model must be a compiled"),
+    ("rtol-none", lambda s, m: mb.simulate(m, 1.0, rtol=None), r"rtol must be a positive"),
+    ("max_step-text", lambda s, m: mb.simulate(m, 1.0, max_step="x"), r"max_step must be"),
+    ("events-none", lambda s, m: mb.simulate(m, 1.0, events=None), r"events must be a list"),
+    ("progress-number", lambda s, m: mb.simulate(m, 1.0, progress=5), r"progress must be"),
+    ("outputs-number", lambda s, m: mb.simulate(m, 0.1, outputs=5), r"outputs must be"),
+    ("points-list", lambda s, m: mb.simulate(m, 0.1, points=[1]), r"points must be"),
+    ("to_csv-none", lambda s, m: mb.simulate(m, 0.1).to_csv(None), r"give a file name"),
+    ("animate-speed-text", lambda s, m: mb.simulate(m, 0.1).animate("x.gif", speed="fast"),
+     r"speed must be a positive number"),
+]
+
+
+@pytest.mark.parametrize("case_id, call, pattern", CORE_CASES, ids=[c[0] for c in CORE_CASES])
+def test_the_core_python_interface_refuses_wrong_arguments_with_its_errors(case_id, call,
+                                                                            pattern):
+    s, m = _pendulum_model()
+    with pytest.raises((mb.ModelError, mb.NonFiniteError), match=pattern):
+        call(s, m)
+
+
+def test_a_zero_quaternion_is_named_by_every_evaluation():
+    s = mb.System("ball", gravity=(0, 0, -9.81))
+    s.add_body("b", mass=1, com=(0, 0, -1), inertia=(1, 1, 1))
+    s.add_joint("j", "spherical", parent="ground", child="b")
+    m = s.compile()
+    q, u = np.zeros(4), np.zeros(3)
+    for call in (lambda: m.forward_dynamics(q, u),
+                 lambda: m.forward_dynamics(q, u, method="articulated"),
+                 lambda: m.state_derivative(0.0, np.zeros(7)), lambda: m.newton_euler(q, u),
+                 lambda: m.kinematics(q, u), lambda: m.mass_matrix(q),
+                 lambda: m.energy(q, u), lambda: m.reactions(q, u),
+                 lambda: m.coordinate_rates(q, u), lambda: m.inverse_dynamics(q, u, u)):
+        with pytest.raises(mb.NonFiniteError, match=r"quaternion j_qw.*no direction"):
+            call()
+
+
+def _block_on_spring(stiffness=None, table=None):
+    s = mb.System("block", gravity=(0, 0, -9.81))
+    s.add_body("block", mass=2.0)
+    s.add_joint("z", "prismatic", parent="ground", child="block", axis="z")
+    kw = dict(force_table=table) if table is not None else dict(stiffness=stiffness)
+    s.add_force("spring", "spring-damper", body_a="block", free_length=1.0,
+                point_b=(0, 0, 2), **kw)
+    return s.compile()
+
+
+def test_a_stiff_model_under_an_implicit_integrator_is_not_told_to_take_one():
+    """Radau on k = 1e12 (an undamped oscillation it must follow) is not told to try
+    Radau; an explicit integrator is."""
+    m = _block_on_spring(stiffness=1e12)
+    with pytest.raises(mb.SimulationError) as info:
+        mb.simulate(m, 3.0, {"z": 0.5}, integrator="Radau")
+    assert "implicit integrator Radau takes tiny steps too" in str(info.value)
+    assert "try Radau" not in str(info.value)
+    with pytest.raises(mb.SimulationError, match="explicit integrator .*try Radau or BDF"):
+        mb.simulate(m, 30.0, {"z": 0.5}, integrator="DOP853")
+
+
+def test_an_absurd_stiffness_stops_early_with_the_stiff_model_message():
+    """k = 1e100 under DOP853: steps of 1e-50 s near t = 0 are far above the rounding of
+    t, so the step projection trips after its first window (it ran to max_samples, for
+    18-45 s, when the rounding limit was measured against 1 s instead of t)."""
+    import time
+    m = _block_on_spring(stiffness=1e100)
+    start = time.perf_counter()
+    with pytest.raises(mb.SimulationError, match=r"would need about .* steps.*explicit"):
+        mb.simulate(m, 3.0, {"z": 0.5}, integrator="DOP853")
+    assert time.perf_counter() - start < 30
+
+
+def test_a_force_element_that_blows_up_is_named():
+    m = _block_on_spring(table=[[0, 0], [1e-3, 1e95]])
+    with pytest.raises(mb.SimulationError, match=r"force element 'spring' \(spring-damper\) "
+                                                 r"gives a force of"):
+        mb.simulate(m, 1.0, {"z": 0.5}, integrator="rk4", dt=1e-3)

@@ -22,6 +22,8 @@ def energy(model, q, u, t=0.0):
 def momentum(model, q, u, t=0.0):
     """Linear momentum ``sum m v_G`` and angular momentum about the world origin
     ``sum (r_G x m v_G + I_G w)`` of all bodies, world components: ``(p, L)``."""
+    q, u = model._state(q, u)
+    model._require_finite(q, u, t)
     kin = model.kinematics(q, u, t=t)
     p = np.zeros(3)
     L = np.zeros(3)

@@ -67,7 +67,11 @@ def state_derivative(model, t, y, method="jourdain"):
     """``[q', u']`` for the state ``y = [q, u]`` in one compiled call: ``q' = N(q) u``
     (``coordinate_rates``) and ``u'`` as ``forward_dynamics`` gives it (``method``:
     ``"jourdain"`` or ``"articulated"``).  Returns a new array."""
-    y = np.asarray(y, dtype=float)
+    try:
+        y = np.asarray(y, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(f"model {model.name!r}: the state y must be {model.nq + model.nu} "
+                         f"numbers (q then u), got {y!r}") from None
     if y.shape != (model.nq + model.nu,):
         raise ModelError(f"model {model.name!r} expects a state of length "
                          f"{model.nq + model.nu} (q then u), got shape {y.shape}")

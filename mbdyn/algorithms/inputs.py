@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError, NonFiniteError, SingularMassMatrixError
+from ..kernels import forces as kf
 
 
 def fill(model, q, u, t):
@@ -139,6 +140,10 @@ def check_finite(model, q, u, t, out, what, names=None):
                 and np.isfinite(model._udfull[ku])):
             raise NonFiniteError(f"model {model.name!r}, t={t:.6g}: the drive of joint "
                                  f"{name!r} gave a non-finite value")
+    blame = force_element_blame(model, q, u, t)
+    if blame:
+        raise NonFiniteError(f"model {model.name!r}, t={t:.6g}: {what} came out non-finite; "
+                             + blame)
     bad = [n for n, x in zip(names or model.speeds, out) if not np.isfinite(x)]
     raise NonFiniteError(f"model {model.name!r}, t={t:.6g}: {what} came out non-finite "
                          f"for {', '.join(bad) or 'some entries'}")
@@ -174,3 +179,33 @@ def division_by_zero(model, q, t=0.0):
     return NonFiniteError(f"model {model.name!r}, t={t:.6g}: a division by zero in the "
                           "numeric kernels at this state; check the coordinates "
                           f"({', '.join(model.coordinates)}) and the model's data")
+
+
+#: a force element's force or moment beyond this (newtons, newton metres) is named as the
+#: likely cause of a non-finite result: squared, or times a step, it leaves the doubles
+HUGE_FORCE = 1e150
+
+
+def force_element_blame(model, q, u, t):
+    """Which force element gives a non-finite or huge force at the state ``(q, u, t)``:
+    each element evaluated alone (its wrench on zeroed loads); the message naming it and
+    its force, or ``None``."""
+    if not model.forces or not model._force_int.shape[0]:
+        return None
+    try:
+        model._kinematics_kernel(np.asarray(q, float), np.asarray(u, float), t)
+    except Exception:           # the state itself is unusable: said by the caller
+        return None
+    F, N = np.zeros_like(model._F), np.zeros_like(model._N)
+    for k, el in enumerate(model._force_elements):
+        F[:] = 0.0
+        N[:] = 0.0
+        kf.force_elements(model._force_int[k:k + 1], model._force_data, model._parent,
+                          model._axis, model._com, model._qfull, model._ufull, model._R,
+                          model._r, model._w, model._v, F, N, np.zeros(2), model._scratch)
+        size = max(np.abs(F).max(initial=0.0), np.abs(N).max(initial=0.0))
+        if not np.isfinite(size) or size > HUGE_FORCE:
+            return (f"force element {el.name!r} ({el.kind}) gives a force of {size:.3g} at "
+                    "this state: check its stiffness, its tables (their slope beyond the "
+                    "last point is held) and the units")
+    return None

@@ -46,7 +46,9 @@ def mass_matrix_by(model, q, t, terms):
 def forcing(model, q, u, t=0.0):
     """The right-hand side ``f(q, u, t)`` of ``M u' = f``: applied, gyroscopic and
     velocity-product terms projected by the Jacobians."""
-    model._jourdain_packed(q, u, t)
+    q, u = model._jourdain_packed(q, u, t)
+    if not np.all(np.isfinite(model._f)):      # a NaN in the state: say so; else as it came
+        model._require_finite(q, u, t)
     return model._f.copy()
 
 

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ModelError
 from ..kernels import evaluate as ke
 from ..kernels import joints as kj
 from ..kernels.kinematics import point_jacobian
@@ -110,11 +111,17 @@ def jacobian_translation(model, q, frame, point=None, t=0.0):
 def point_positions(model, q, points, t=0.0):
     """World positions of points fixed on frames: ``points`` is a list of
     ``(frame, offset in the frame's components)``; returns an array (len(points), 3)."""
+    try:
+        specs = [(frame, np.asarray(offset, dtype=float).reshape(3))
+                 for frame, offset in points]
+    except (TypeError, ValueError):
+        raise ModelError("point_positions: points must be a list of (frame, offset) with "
+                         f"offset three numbers, got {points!r}") from None
     model._kinematics_kernel(q, np.zeros(model.nu), t)
-    out = np.empty((len(points), 3))
-    for k, (frame, offset) in enumerate(points):
+    out = np.empty((len(specs), 3))
+    for k, (frame, offset) in enumerate(specs):
         i = model.frame_index(frame)
-        out[k] = model._r[i] + model._R[i] @ np.asarray(offset, dtype=float)
+        out[k] = model._r[i] + model._R[i] @ offset
     return out
 
 

@@ -54,7 +54,11 @@ def inverse_dynamics(model, q, u, u_dot, t=0.0, frame="world"):
     joint's speed, a force on a prismatic one), and ``reactions`` ``{joint: (F, M)}``
     as ``Model.reactions`` gives them, the joints transmitting those efforts too."""
     q, u = model._state(q, u)
-    ud = np.asarray(u_dot, dtype=float)
+    try:
+        ud = np.asarray(u_dot, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(f"model {model.name!r}: u_dot must be {model.nu} numbers, got "
+                         f"{u_dot!r}") from None
     if ud.shape != (model.nu,):
         raise ModelError(f"model {model.name!r}: u_dot needs {model.nu} values, got "
                          f"{ud.size}")

@@ -6,6 +6,8 @@ freedom) at ``compile()``.  Every error names the element and says what to chang
 """
 from __future__ import annotations
 
+import collections.abc
+import math
 import warnings
 
 import networkx as nx
@@ -19,6 +21,7 @@ from ..elements.bodies import inertia_tensor, make_body
 from ..elements.joints import make_joint
 from ..elements.loads import make_load
 from ..errors import ModelError, ModelWarning, SingularMassMatrixError
+from ..limits import magnitude_problem
 from ..names import identifier_problem, label_problem
 from ..elements.forces import GLOBAL_EFFECTS, make_force
 
@@ -38,6 +41,9 @@ class System:
     def __init__(self, name="system", gravity=(0.0, 0.0, -9.81), parameters=None):
         self.name = str(name)
         self.parameters = {}
+        if parameters is not None and not isinstance(parameters, collections.abc.Mapping):
+            raise ModelError(f"system {name!r}: parameters must be a mapping {{name: value}}, "
+                             f"got {type(parameters).__name__}")
         for pname, value in (parameters or {}).items():
             problem = identifier_problem(pname)
             if problem:
@@ -47,6 +53,10 @@ class System:
             except (TypeError, ValueError):
                 raise ModelError(f"system {name!r}: parameter {pname!r} must be a number, "
                                  f"got {value!r}") from None
+            problem = (f"is {value!r}; give a finite number" if not math.isfinite(
+                self.parameters[pname]) else magnitude_problem(self.parameters[pname]))
+            if problem:
+                raise ModelError(f"system {name!r}: parameter {pname!r} {problem}")
         self.gravity_symbolic = gravity if has_symbols(gravity) else None
         gravity = numeric(gravity, self.parameters, f"system {name!r}", "gravity")
         try:
@@ -67,7 +77,13 @@ class System:
     # ------------------------------------------------------------------ building
     def symbols(self, names):
         """sympy symbols of declared parameters: ``m, l = s.symbols("m l")``."""
-        names = names.replace(",", " ").split() if isinstance(names, str) else list(names)
+        if isinstance(names, str):
+            names = names.replace(",", " ").split()
+        elif isinstance(names, (list, tuple)) and all(isinstance(n, str) for n in names):
+            names = list(names)
+        else:
+            raise ModelError(f"system {self.name!r}: symbols takes parameter names, as one "
+                             f"text ('m l') or a list of texts, got {names!r}")
         missing = [n for n in names if n not in self.parameters]
         if missing:
             raise ModelError(f"system {self.name!r}: {', '.join(missing)} are not parameters; "
@@ -100,8 +116,7 @@ class System:
         if inertia_about == "origin":
             if inertia is None:
                 raise ModelError(f"body {name!r}: inertia_about='origin' needs an inertia")
-            I_O = sympy.Matrix(np.diag(inertia) if np.ndim(inertia) == 1 else inertia)
-            c = sympy.Matrix(list(com))
+            I_O, c, mass = _origin_inertia_parts(name, mass, com, inertia)
             I_G = I_O - mass * ((c.T * c)[0, 0] * sympy.eye(3) - c * c.T)
             inertia = [[float(v) if not getattr(v, "free_symbols", None) else v
                         for v in I_G.row(r)] for r in range(3)]
@@ -172,6 +187,9 @@ class System:
         numbers (``q``, ``u`` arrays in ``Model.coordinates``/``Model.speeds`` order);
         ``frame``: ``"world"`` or ``"body"`` components.
         """
+        problem = label_problem(name)
+        if problem:
+            raise ModelError(f"load name {name!r} {problem}")
         if name in self._loads or name in self._forces or name in GLOBAL_EFFECTS:
             raise ModelError(f"load {name!r}: the name is already used by another load, a "
                              "force element or an effect; loads and force elements share "
@@ -310,3 +328,31 @@ def _check_inertia_of_every_dof(model, samples=3, seed=12345):
                      "carry no inertia -- the mass matrix is singular in every configuration.  "
                      "Give the bodies these joints move mass or inertia about the joint axes, "
                      "or remove (fix) those joints." + hint)
+
+
+def _origin_inertia_parts(name, mass, com, inertia):
+    """``(I_O, c, m)`` as sympy objects for ``inertia_about="origin"``: the inertia about
+    the origin (three principal moments or a 3x3 tensor), the centre of mass (three
+    values) and the mass (a number or an expression), each checked first."""
+    element = f"body {name!r}"
+    if not (isinstance(mass, (int, float, sympy.Basic)) and not isinstance(mass, bool)):
+        raise ModelError(f"{element}: mass must be a number or an expression of parameters, "
+                         f"got {mass!r}")
+    shape = np.shape(np.asarray(inertia, dtype=object))
+    if shape not in ((3,), (3, 3)):
+        raise ModelError(f"{element}: inertia_about='origin' takes three principal moments "
+                         f"or a 3x3 tensor, got {inertia!r}")
+    if np.shape(np.asarray(com, dtype=object)) != (3,):
+        raise ModelError(f"{element}: com must be three values, got {com!r}")
+    entries = list(np.ravel(np.asarray(inertia, dtype=object))) + list(com)
+    if not all(isinstance(v, (int, float, np.number, sympy.Basic)) and not isinstance(v, bool)
+               for v in entries):
+        raise ModelError(f"{element}: inertia and com must be numbers or sympy expressions "
+                         "of parameters")
+    try:
+        I_O = sympy.Matrix(np.diag(inertia) if shape == (3,) else inertia)
+        c = sympy.Matrix(list(com))
+    except (TypeError, ValueError, sympy.SympifyError):
+        raise ModelError(f"{element}: inertia and com must be numbers or expressions of "
+                         "parameters") from None
+    return I_O, c, mass

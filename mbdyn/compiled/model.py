@@ -82,17 +82,17 @@ class Model:
     # ------------------------------------------------------------------ names and records
     def joint(self, name):
         """The joint record (kind, axis, parent, child, coordinates, drive...)."""
-        return self._joint[name]
+        return _look_up(self._joint, name, "joint", self.joints)
 
     def body(self, name):
         """The body record (mass, com, inertia about the centre of mass)."""
-        return self._body[name]
+        return _look_up(self._body, name, "body or frame", self.frames)
 
     def coordinate_index(self, name):
-        return self._coordinate_index[name]
+        return _look_up(self._coordinate_index, name, "coordinate", self.coordinates)
 
     def speed_index(self, name):
-        return self._speed_index[name]
+        return _look_up(self._speed_index, name, "speed", self.speeds)
 
     def frame_index(self, name):
         try:
@@ -223,3 +223,12 @@ class Model:
             raise ModelError(f"loop_arguments: no compiled loop for method {method!r}")
         return (self.nq, slots, quats, self._free_q, self._free_u, drive_q, drive_u,
                 tree, body, self._loads_arrays, ws)
+
+
+def _look_up(table, name, what, known):
+    """``table[name]``, or a ``ModelError`` listing the names there are."""
+    try:
+        return table[name]
+    except (KeyError, TypeError):
+        raise ModelError(f"unknown {what} {name!r}; the model's are "
+                         f"{', '.join(map(str, known)) or '(none)'}") from None

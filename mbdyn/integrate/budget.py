@@ -62,8 +62,7 @@ def over_budget(budget, steps, stored, t, t_end, h=None):
     if steps >= budget["max_steps"]:
         stiff = ""
         if h is not None:
-            stiff = (f"; the last step was {h:.3g} s -- a stiff model under an explicit "
-                     "integrator takes tiny steps: try Radau or BDF")
+            stiff = f"; the last step was {h:.3g} s -- {slow_pace_hint(budget)}"
         return (f"stopped after max_steps = {budget['max_steps']} steps at t={t:.6g} of "
                 f"{t_end:.6g}{stiff}; or raise max_steps (--max-steps)")
     if stored > budget["max_samples"]:
@@ -84,7 +83,7 @@ PROJECTION_STEPS = 1000
 def projected_over_budget(budget, steps, t, t_end, recent):
     """Stop early a run that cannot finish within ``max_steps`` at its current pace."""
     h = float(np.median(recent))
-    if not h > 1e4 * np.finfo(float).eps * max(1.0, abs(t)):
+    if not h > 1e4 * np.finfo(float).eps * abs(t):
         return None     # at the rounding limit: the integrator's own failure follows, precisely
     projected = steps + (t_end - t) / h
     if projected <= budget["max_steps"]:
@@ -94,9 +93,24 @@ def projected_over_budget(budget, steps, t, t_end, recent):
                 f"becomes singular near t={t:.6g}: check it" if drives else "")
     return (f"stopped at t={t:.6g} of {t_end:.6g} after {steps} steps: at its current step "
             f"size (median {h:.3g} s) the run would need about {projected:.2g} steps, more "
-            f"than max_steps = {budget['max_steps']} -- a stiff model under an explicit "
-            f"integrator takes tiny steps: try Radau or BDF{suspects}; or raise max_steps "
-            "(--max-steps)")
+            f"than max_steps = {budget['max_steps']} -- {slow_pace_hint(budget)}{suspects}; "
+            "or raise max_steps (--max-steps)")
+
+
+#: integrators that solve implicit equations each step (stable on stiff models)
+IMPLICIT = ("Radau", "BDF", "LSODA", "implicit-midpoint")
+
+
+def slow_pace_hint(budget):
+    """Why a run may take tiny steps, and what to do, for the run's integrator."""
+    integrator = budget.get("integrator")
+    if integrator in IMPLICIT:
+        return (f"the implicit integrator {integrator} takes tiny steps too, so the motion "
+                "itself is fast (an undamped stiff oscillation, which any integrator must "
+                "follow, or a very fast rotation) or not smooth: check the stiffnesses and "
+                "the units, loosen rtol/atol, or shorten t_end")
+    return ("a stiff model under an explicit integrator takes tiny steps: try Radau or BDF, "
+            "and check the stiffnesses and the units")
 
 
 def stretch_budget_ends(budget, steps, kept, T, H, t_end, recent):

@@ -8,6 +8,7 @@ import warnings
 
 import numpy as np
 
+from ..algorithms.inputs import force_element_blame
 from ..errors import (NonFiniteError, SingularityWarning, SingularMassMatrixError)
 
 
@@ -103,9 +104,15 @@ def conditioning(model, q, t, stats, key, stacklevel=3):
 
 
 def describe_failure(model, exc, t, y):
+    """The message of a failed step: the error, where it stopped, the last good state, and
+    for a non-finite result the force element that gives a huge force there, if one does."""
     names = model.coordinates + model.speeds
     state = ", ".join(f"{n}={v:.6g}" for n, v in zip(names, y))
-    return f"{exc} (integration stopped at t={t:.6g}; last good state: {state})"
+    blame = ""
+    if isinstance(exc, NonFiniteError) and "force element" not in str(exc):
+        found = force_element_blame(model, y[:model.nq], y[model.nq:], t)
+        blame = f"; {found}" if found else ""
+    return f"{exc} (integration stopped at t={t:.6g}; last good state: {state}){blame}"
 
 
 LOOP_STATUS = {

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import (ModelError)
+from ..errors import ModelError
 from .balance import energy_balance
 from .settings import OUTPUTS
 
@@ -54,6 +54,9 @@ class Result:
         speeds, then the energies, reactions, drive efforts and points computed), the same
         columns as ``mbdyn run --out``; written whole or not at all."""
         import io as _io
+        import os
+        if not isinstance(path, (str, os.PathLike)) or not str(path):
+            raise ModelError(f"to_csv: give a file name, got {path!r}")
         names = ["t"] + list(self.coordinates) + list(self.speeds)
         cols = [self.t[:, None], self.q, self.u]
         if self.energy is not None:
@@ -116,6 +119,12 @@ class Result:
     def compute_outputs(self, outputs=(), points=None, method="auto", frame="world"):
         """Evaluate reactions (``frame``: ``"world"`` or ``"child"`` components), energies
         and point trajectories along the stored motion."""
+        if (isinstance(outputs, str) or not isinstance(outputs, (list, tuple, set))
+                or not all(isinstance(o, str) for o in outputs)):
+            raise ModelError(f"outputs must be a list of names ({', '.join(OUTPUTS)}), got "
+                             f"{outputs!r}")
+        if points is not None and not isinstance(points, dict):
+            raise ModelError(f"points must be {{name: (frame, offset)}}, got {points!r}")
         model = self.model
         unknown = set(outputs) - set(OUTPUTS)
         if unknown:

@@ -73,10 +73,12 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     """
     if not hasattr(model, "forward_dynamics") and hasattr(model, "compile"):
         model = model.compile()           # a System: compile it here
+    _check_kinds(model, events, progress)
     method = _check_method(model, integrator, method)
     t0, t_end = _check_interval(t0, t_end, events, rtol, atol, max_step)
     budget = make_budget(max_steps, max_samples, max_wall_time, decimate)
     budget["drives"] = [d[0] for d in getattr(model, "_driven", ())]
+    budget["integrator"] = integrator
     t_eval = _check_t_eval(t_eval, t0, t_end)
     q, u = _initial_state(model, q0, u0)
     events = [as_event(e, model) for e in events]
@@ -113,6 +115,20 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     return result
 
 
+def _check_kinds(model, events, progress):
+    """The arguments whose kind is wrong, refused before anything else looks at them."""
+    from ..compiled.model import Model
+    if not isinstance(model, Model):
+        raise ModelError(f"simulate: model must be a compiled Model or a System, got "
+                         f"{type(model).__name__}")
+    if events is None or not (hasattr(events, "__iter__") or isinstance(events, Event)):
+        raise ModelError("simulate: events must be a list of mb.Event (or empty), got "
+                         f"{events!r}")
+    if progress is not None and not callable(progress):
+        raise ModelError(f"simulate: progress must be a function progress(t), got "
+                         f"{progress!r}")
+
+
 def _check_method(model, integrator, method):
     """The formulation a run uses (``"auto"`` resolved by the model's size)."""
     if integrator not in INTEGRATORS:
@@ -136,11 +152,11 @@ def _check_interval(t0, t_end, events, rtol, atol, max_step):
         raise ModelError(f"t0 and t_end must be finite, got {t0} and {t_end}")
     if not t_end > t0:
         raise ModelError(f"t_end ({t_end}) must be greater than t0 ({t0})")
-    for name, value in (("rtol", rtol), ("atol", atol)):
-        if not (np.isfinite(value) and value > 0):
-            raise ModelError(f"{name} must be a positive number, got {value!r}")
-    if not max_step > 0:
-        raise ModelError(f"max_step must be positive, got {max_step!r}")
+    for name, value in (("rtol", rtol), ("atol", atol), ("max_step", max_step)):
+        if (isinstance(value, bool) or not isinstance(value, (int, float, np.number))
+                or not (value > 0 and (np.isfinite(value) or name == "max_step"))):
+            what = "positive" if name == "max_step" else "a positive number"
+            raise ModelError(f"{name} must be {what}, got {value!r}")
     return t0, t_end
 
 

@@ -30,7 +30,6 @@ from ..assembly.system import GROUND, System
 from ..integrate.settings import DEFAULTS as SIMULATE_DEFAULTS
 from ..integrate.settings import FIXED_STEP, INTEGRATORS
 from ..integrate.events import Event
-from ..integrate.result import Result
 from ..integrate.simulation import simulate as _simulate
 from ..integrate.events import sympy_condition as _condition
 from ..elements.expressions import expanded_terms

@@ -38,8 +38,10 @@ def animate(result, out, speed=1.0, fps=30.0, title=None, max_frames=MAX_FRAMES)
     """Write an animation of ``result`` to ``out`` (.gif, .mp4 or .html); returns the
     number of frames.  The file is written whole or not at all."""
     ext = check_output(out)
-    if not (speed > 0 and fps > 0):
-        raise ModelError(f"speed and fps must be positive, got {speed} and {fps}")
+    for name, value in (("speed", speed), ("fps", fps)):
+        if (isinstance(value, bool) or not isinstance(value, (int, float, np.number))
+                or not (value > 0 and np.isfinite(value))):
+            raise ModelError(f"{name} must be a positive number, got {value!r}")
     if ext == ".gif":
         # a GIF stores frame durations in whole centiseconds: make them exact
         fps = 100.0 / max(1, round(100.0 / fps))
