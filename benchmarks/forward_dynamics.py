@@ -309,7 +309,7 @@ class Raw:
             self.jargs = packed_args(model, q, u)
             self.ud = model._ud
             self.prebuilt = True
-            self.neargs = self.jargs
+            self.neargs = tuple(self.jargs) + tuple(model._dense_system())
             self.jk = kp.jourdain_accelerations_packed
             self.nek = kp.newton_euler_solution_packed
             ref = model.forward_dynamics(q, u, 0.0, method="jourdain")

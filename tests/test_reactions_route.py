@@ -18,7 +18,7 @@ def test_newton_euler_route_is_bit_identical_to_the_fused_kernel(seed):
     m, q, u, t = tr.model, tr.q, tr.u, tr.t
     if m._python_inputs:
         m._fill_inputs(q, u, t)
-    fused, _ = kp.newton_euler_solution_packed(*m._packed, q, u)   # numba's np.linalg.solve
+    fused, _ = kp.newton_euler_solution_packed(*m._packed, q, u, *m._dense_system())   # numba's np.linalg.solve
     ud, reactions = m.newton_euler(q, u, t, dense=True)
     assert np.array_equal(ud, fused[:m.nu])
     assert np.array_equal(m._newton_euler(q, u, t, dense=True), fused)

@@ -51,12 +51,13 @@ def solve(model, q, u, t, dense=False):
         # the LU solve from Python: no fused entry point of its own to compile
         model._kinematics_kernel(q, u, t)
         model._drop_velocity_products()
+        A, b = model._dense_system()
         kd.newton_euler_system(model._mass, model._com, model._inertia, model._parent,
                                model._R, model._r, model._w, model._alpha, model._a,
                                model._JR, model._JT, model._anc_ptr, model._anc_idx,
                                model._F, model._N, model._react_joint,
-                               model._react_force, model._react_moment, model._A, model._b)
-        x = _lu_solve(model._A, model._b)
+                               model._react_force, model._react_moment, A, b)
+        x = _lu_solve(A, b)
         finite = bool(np.all(np.isfinite(x)))
     except np.linalg.LinAlgError:     # singular, or fed NaN/Inf: tell which
         model._jourdain_terms(q, u, t)

@@ -181,9 +181,11 @@ def loads(model, records):
 
 def workspace(model, joints):
     """The arrays every evaluation writes into: joint-space state, frame motion, Jacobians,
-    applied loads, ``M``, ``f`` and their factor, the dense Newton-Euler system, the
-    articulated inertias, the reaction unknowns, and one scratch array for the kernels'
-    temporaries (``kernels.evaluate.scratch_size``)."""
+    applied loads, ``M``, ``f`` and their factor, the articulated inertias, the reaction
+    unknowns, and one scratch array for the kernels' temporaries
+    (``kernels.evaluate.scratch_size``).  The dense Newton-Euler system (6n x 6n) is not
+    here: only its route needs it, and it is allocated on its first use
+    (``Model._dense_system``): a 5,000-body model would otherwise hold 7 GB for it."""
     n, nu = model.n_frames, model.nu
     model._qfull = np.zeros(model._nq_full)
     model._ufull = np.zeros(model._nu_full)
@@ -202,8 +204,6 @@ def workspace(model, joints):
     model._M = np.zeros((nu, nu))
     model._f = np.zeros(nu)
     model._L = np.zeros((nu, nu))
-    model._A = np.zeros((6 * n, 6 * n))
-    model._b = np.zeros(6 * n)
     model._ud = np.zeros(nu)
     # articulated bodies (kernels.articulated): per frame 6x6 inertias, biases, the
     # joint's U = IA S and Cholesky factor of D, accelerations, joint wrenches

@@ -179,6 +179,14 @@ class Model:
     euler_singularity = diagnosis.euler_singularity
     mass_matrix_condition = diagnosis.mass_matrix_condition
 
+    def _dense_system(self):
+        """``(A, b)``: the workspace of the dense Newton-Euler system (6n x 6n and 6n),
+        allocated on the first use of that route and kept."""
+        if getattr(self, "_A", None) is None:
+            self._A = np.zeros((6 * self.n_frames, 6 * self.n_frames))
+            self._b = np.zeros(6 * self.n_frames)
+        return self._A, self._b
+
     def lowlevel(self, method="auto"):
         """The low-level entry (``mbdyn.compiled.lowlevel.LowLevel``):
         ``forward_dynamics(q, u)`` and ``state_derivative(y)`` as single compiled calls on

@@ -93,9 +93,11 @@ class Monitor:
 
 
 def conditioning(model, q, t, stats, key, stacklevel=3):
+    """``stats[key]``: the condition number of ``M`` at ``q`` (``None`` where too large a
+    model makes it cost more than the run); a ``SingularityWarning`` when it is large."""
     cond, weak = model.mass_matrix_condition(q, t)
     stats[key] = cond
-    if cond > CONDITION_WARNING:
+    if cond is not None and cond > CONDITION_WARNING:
         warnings.warn(f"model {model.name!r} at t={t:.6g}: the mass matrix is nearly singular "
                       f"(condition number {cond:.3g}; about {np.log10(cond):.0f} of 16 digits "
                       f"are lost); speeds {', '.join(weak)} carry almost no inertia.  Check "

@@ -24,7 +24,7 @@ from .views import UNCOUNTED, c_view, untracked
 #: float arrays in buffer order, with their shapes in terms of the sizes below
 FLOATS = ("gravity", "axis", "pos", "C", "mass", "com", "inertia", "load_point", "load_force",
           "load_moment", "react_force", "react_moment", "qfull", "ufull", "udfull", "R", "r",
-          "w", "v", "alpha", "a", "JR", "JT", "F", "N", "M", "f", "L", "A", "b", "ud",
+          "w", "v", "alpha", "a", "JR", "JT", "F", "N", "M", "f", "L", "ud",
           "force_data", "IA", "pA", "cb", "U", "Dl", "acc", "W", "lam", "scratch")
 #: integer arrays in buffer order (the two flags, has_inertia and load_in_body, as 0/1)
 INTS = ("parent", "kind", "seq", "qoff", "uoff", "ucol", "anc_ptr", "anc_idx", "has_inertia",
@@ -37,7 +37,7 @@ SIZES = ("n", "nu", "nl", "nqf", "nuf", "nanc", "nreact", "nq", "nslots", "ne", 
          "nscratch")
 
 (GRAVITY, AXIS, POS, C, MASS, COM, INERTIA, LOAD_POINT, LOAD_FORCE, LOAD_MOMENT, REACT_FORCE,
- REACT_MOMENT, QFULL, UFULL, UDFULL, R, RR, W, V, ALPHA, A, JR, JT, F, N, M, FF, L, AA, B,
+ REACT_MOMENT, QFULL, UFULL, UDFULL, R, RR, W, V, ALPHA, A, JR, JT, F, N, M, FF, L,
  UD, FORCE_DATA, IA, PA, CB, U, DL, ACC, WRENCH, LAM, SCRATCH) = range(len(SIZES),
                                                                 len(SIZES) + len(FLOATS))
 (PARENT, KIND, SEQ, QOFF, UOFF, UCOL, ANC_PTR, ANC_IDX, HAS_INERTIA, LOAD_BODY, LOAD_IN_BODY,
@@ -85,7 +85,7 @@ def _views(fb, ib, t):
     """Every packed array as a view, in the order of the unpacked kernels' arguments:
     tree (11), body (mass, com, inertia, has_inertia, gravity), joint-space state (3),
     loads (5, then force elements and effect switches: 3), reactions (3), motion (10),
-    Jourdain (M, f, L, ud), Newton-Euler (A, b), articulated bodies (the frames' own
+    Jourdain (M, f, L, ud), articulated bodies (the frames' own
     columns ``own_ptr``, ``own_idx``, then the workspace of ``articulated.articulated_body``
     and the joint wrenches and reaction components), and the evaluations' scratch.
     Offsets are read from ``t`` at run time: literal constants as arguments would make
@@ -124,8 +124,6 @@ def _views(fb, ib, t):
               c_view(fb, t[F], (n, 3)), c_view(fb, t[N], (n, 3)))
     jourdain = (c_view(fb, t[M], (nu, nu)), fb[t[FF]:t[FF] + nu],
                 c_view(fb, t[L], (nu, nu)), fb[t[UD]:t[UD] + nu])
-    newton_euler = (c_view(fb, t[AA], (6 * n, 6 * n)),
-                    fb[t[B]:t[B] + 6 * n])
     articulated = (ib[t[OWN_PTR]:t[OWN_PTR] + n + 1], ib[t[OWN_IDX]:t[OWN_IDX] + nu],
                    c_view(fb, t[IA], (n, 6, 6)),
                    c_view(fb, t[PA], (n, 6)),
@@ -136,8 +134,7 @@ def _views(fb, ib, t):
                    c_view(fb, t[WRENCH], (n, 6)),
                    fb[t[LAM]:t[LAM] + nreact])
     scratch = fb[t[SCRATCH]:t[SCRATCH] + t[11]]
-    return (tree, body, state, loads, reactions, motion, jourdain, newton_euler, articulated,
-            scratch)
+    return tree, body, state, loads, reactions, motion, jourdain, articulated, scratch
 
 
 @njit(inline="always", **UNCOUNTED)
@@ -158,7 +155,7 @@ def jourdain_accelerations_packed(fb, ib, t, q, u):
     """Scatter ``q``, ``u``, then ``evaluate.jourdain_accelerations`` on packed arrays (same
     return value; ``u'`` is left in the ``ud`` view)."""
     _scatter(fb, ib, t, q, u)
-    tree, body, state, loads, _, motion, jourdain, _, _, scratch = _views(fb, ib, t)
+    tree, body, state, loads, _, motion, jourdain, _, scratch = _views(fb, ib, t)
     return jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch)
 
 
@@ -168,7 +165,7 @@ def state_derivative_packed(fb, ib, t, y, ydot):
     Cholesky factorization of ``M`` broke down, or -2 when ``ydot`` holds NaN or Inf."""
     nq = t[7]
     _scatter(fb, ib, t, y[:nq], y[nq:])
-    tree, body, state, loads, _, motion, jourdain, _, _, scratch = _views(fb, ib, t)
+    tree, body, state, loads, _, motion, jourdain, _, scratch = _views(fb, ib, t)
     pivot = jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch)
     if pivot >= 0:
         return pivot
@@ -191,14 +188,16 @@ def _state_rates(fb, ib, t, y, ydot):
 
 
 @njit(cache=True)
-def newton_euler_solution_packed(fb, ib, t, q, u):
-    """Scatter ``q``, ``u``, then ``evaluate.newton_euler_solution`` on packed arrays.
-    Returns the unknowns ``x = [ud, lambda]`` (a new array) and whether all are finite."""
+def newton_euler_solution_packed(fb, ib, t, q, u, A, b):
+    """Scatter ``q``, ``u``, then ``evaluate.newton_euler_solution`` on packed arrays, the
+    dense system in ``A`` (6n x 6n) and ``b`` (6n): they are not in the packed buffers,
+    being O(n^2) and needed by this route only (``Model._dense_system``).  Returns the
+    unknowns ``x = [ud, lambda]`` (a new array) and whether all are finite."""
     _scatter(fb, ib, t, q, u)
-    tree, body, state, loads, reactions, motion, _, newton_euler, _, scratch = _views(fb, ib, t)
+    tree, body, state, loads, reactions, motion, _, _, scratch = _views(fb, ib, t)
     mass, com, inertia, _, gravity = body
     x = newton_euler_solution(*tree, mass, com, inertia, gravity, *state, *loads,
-                              *reactions, *motion, *newton_euler, scratch)
+                              *reactions, *motion, A, b, scratch)
     finite = True
     for k in range(x.shape[0]):
         finite = finite and np.isfinite(x[k])
@@ -210,7 +209,7 @@ def articulated_accelerations_packed(fb, ib, t, q, u):
     """Scatter ``q``, ``u``, then ``evaluate.articulated_accelerations`` on packed arrays
     (same return value; ``u'`` is left in the ``ud`` view)."""
     _scatter(fb, ib, t, q, u)
-    tree, body, state, loads, _, motion, jourdain, _, art, scratch = _views(fb, ib, t)
+    tree, body, state, loads, _, motion, jourdain, art, scratch = _views(fb, ib, t)
     mass, com, inertia, _, gravity = body
     return articulated_accelerations(tree[:9] + art[:2], (mass, com, inertia, gravity), state,
                                      loads, motion, art[2:8], jourdain[3], scratch)
@@ -231,7 +230,7 @@ def newton_euler_tree_packed(fb, ib, t, q, u):
     """Scatter ``q``, ``u``, then ``evaluate.newton_euler_tree`` on packed arrays: ``u'``
     in the ``ud`` view, the reaction components in ``lam``; same return value."""
     _scatter(fb, ib, t, q, u)
-    tree, body, state, loads, reactions, motion, jourdain, _, art, scratch = _views(fb, ib, t)
+    tree, body, state, loads, reactions, motion, jourdain, art, scratch = _views(fb, ib, t)
     mass, com, inertia, _, gravity = body
     return newton_euler_tree(*tree[:9], *art[:2], mass, com, inertia, gravity, *state, *loads,
                              *reactions, *motion, *art[2:9], jourdain[3], art[9], scratch)
