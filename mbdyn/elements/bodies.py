@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ModelError, ModelWarning
-from .values import _vector3, has_symbols, numeric, parse_axis
+from .values import _vector3, has_symbols, numeric, parse_axis, square_matrix
 
 
 @dataclass(frozen=True)
@@ -115,18 +115,8 @@ def inertia_tensor(inertia, element):
     a 3x3 matrix.  Warns when the principal moments break the triangle inequality."""
     if inertia is None or (np.isscalar(inertia) and inertia == 0):
         return np.zeros((3, 3))
-    try:
-        arr = np.asarray(inertia, dtype=float)
-    except (TypeError, ValueError):
-        raise ModelError(f"{element}: inertia must be None, three principal moments or a "
-                         f"3x3 tensor, got {inertia!r}") from None
-    if arr.shape == (3,):
-        arr = np.diag(arr)
-    if arr.shape != (3, 3):
-        raise ModelError(f"{element}: inertia must be None, three principal moments or a "
-                         f"3x3 tensor, got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ModelError(f"{element}: inertia has non-finite entries")
+    arr = square_matrix(inertia, 3, element, "inertia must be None, three principal moments "
+                        "or a 3x3 tensor", "inertia has non-finite entries", show=True)
     scale = max(np.abs(arr).max(), 1e-300)
     if np.abs(arr - arr.T).max() > 1e-9 * scale:
         raise ModelError(f"{element}: inertia tensor is not symmetric; "

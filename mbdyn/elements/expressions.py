@@ -19,6 +19,9 @@ import math
 import sympy
 
 from .. import limits
+from .evaluation import (FLOAT_FUNCTIONS, ExpressionError, _float_call, _float_power,  # noqa: F401
+                         to_float)
+from .expansion import ObjectMemo, expanded_terms  # noqa: F401  (their old import path)
 
 #: Functions an expression may call: name -> (sympy function, allowed numbers of arguments).
 FUNCTIONS = {
@@ -65,54 +68,9 @@ ALLOWED_SUMMARY = ("numbers, names, + - * / **, parentheses, pi and the function
                    + ", ".join(FUNCTIONS))
 
 
-class ExpressionError(ValueError):
-    """An expression that cannot be read; the message quotes it and says what is allowed."""
-
-
 def symbol(name):
     """The sympy symbol a model file uses for ``name`` (real, as ``System.symbols``)."""
     return sympy.Symbol(name, real=True)
-
-
-#: The same functions on floats, for the value of constant parts and of ``to_float``.
-FLOAT_FUNCTIONS = {
-    "sin": math.sin, "cos": math.cos, "tan": math.tan, "asin": math.asin, "acos": math.acos,
-    "atan": math.atan, "atan2": math.atan2, "sinh": math.sinh, "cosh": math.cosh,
-    "tanh": math.tanh, "sqrt": math.sqrt, "exp": math.exp,
-    "log": lambda x, b=None: math.log(x) if b is None else math.log(x, b),
-    "abs": abs, "sign": lambda x: math.copysign(1.0, x) if x else 0.0, "min": min, "max": max,
-}
-
-
-def _float_call(fname, args):
-    """``FLOAT_FUNCTIONS[fname](*args)``, or the reason it has no finite real value."""
-    try:
-        v = FLOAT_FUNCTIONS[fname](*args)
-    except OverflowError:
-        return None, f"{fname}() overflows (beyond {MAX_CONSTANT:g})"
-    except (ValueError, ZeroDivisionError):
-        shown = ", ".join(f"{a:.6g}" for a in args)
-        if fname == "log" and args[0] == 0:
-            return None, "log(0) is not finite"
-        return None, (f"{fname}({shown}) is not a real number (outside the function's "
-                      "domain)")
-    if isinstance(v, complex) or not math.isfinite(v):
-        return None, f"{fname}() has no finite real value here"
-    return float(v), None
-
-
-def _float_power(a, b):
-    try:
-        v = a ** b
-    except OverflowError:
-        return None, f"the power {a:.6g}**{b:.6g} overflows (beyond {MAX_CONSTANT:g})"
-    except ZeroDivisionError:
-        return None, "zero to a negative power"
-    if isinstance(v, complex):
-        return None, f"{a:.6g}**{b:.6g} is not a real number"
-    if not math.isfinite(v):
-        return None, f"the power {a:.6g}**{b:.6g} overflows (beyond {MAX_CONSTANT:g})"
-    return float(v), None
 
 
 class _Builder:
@@ -352,127 +310,3 @@ def names_in(text):
     else:
         builder.build(node)
     return set(builder.used)
-
-
-def to_float(expr, values=None):
-    """``float`` of a sympy expression with ``values`` ``{name: number}`` for its symbols;
-    raises ``ExpressionError`` if it is not a finite real number.
-
-    Evaluated in floating point node by node (never ``evalf``, whose exact arithmetic on
-    a huge constant such as ``sin(exp(exp(exp(9))))`` has no time bound).
-    """
-    if isinstance(expr, (int, float)) and not isinstance(expr, bool):
-        v = float(expr)
-        if not math.isfinite(v):
-            raise ExpressionError(f"{expr} is not finite")
-        return v
-    missing = sorted(s.name for s in expr.free_symbols if s.name not in (values or {}))
-    if missing:
-        raise ExpressionError(f"{expr} still depends on {', '.join(missing)}")
-    v = _evaluate(expr, values or {})
-    if abs(v) > MAX_CONSTANT:
-        raise ExpressionError(f"{expr} is too large ({v:.6g}; the limit is {MAX_CONSTANT:g})")
-    return v
-
-
-_SYMPY_FLOAT = {"Abs": "abs", "Min": "min", "Max": "max"}
-
-
-def _evaluate(expr, values):
-    """The float value of ``expr`` (symbols from ``values``), iteratively over its tree."""
-    memo = {}
-    stack = [expr]
-    while stack:
-        e = stack[-1]
-        if e in memo:
-            stack.pop()
-            continue
-        pending = [a for a in e.args if a not in memo]
-        if pending and not (e.is_Number or e.is_NumberSymbol or e.is_Symbol):
-            stack.extend(pending)
-            continue
-        stack.pop()
-        memo[e] = _evaluate_node(e, [memo.get(a) for a in e.args], values)
-    return memo[expr]
-
-
-def _evaluate_node(e, args, values):
-    if e.is_Symbol:
-        v = float(values[e.name])
-    elif e.is_Integer:
-        if abs(e.p).bit_length() > 1024:
-            raise ExpressionError(f"an integer of {len(str(abs(e.p)))} digits is too large")
-        v = float(e.p)
-    elif e.is_Number or e.is_NumberSymbol:
-        try:
-            v = float(e)
-        except (TypeError, OverflowError):
-            raise ExpressionError(f"{e} is not a finite real number") from None
-    elif e.is_Add:
-        v = math.fsum(args)
-    elif e.is_Mul:
-        v = math.prod(args)
-    elif e.is_Pow:
-        v, why = _float_power(*args)
-        if why:
-            raise ExpressionError(why)
-    else:
-        name = type(e).__name__
-        fname = _SYMPY_FLOAT.get(name, name)
-        if fname == "exp" or fname in FLOAT_FUNCTIONS:
-            v, why = _float_call(fname, args)
-            if why:
-                raise ExpressionError(why)
-        elif e == sympy.I or e.is_imaginary:
-            raise ExpressionError(f"{e} is not a real number")
-        else:
-            raise ExpressionError(f"{e} cannot be evaluated to a number")
-    if not math.isfinite(v):
-        raise ExpressionError(f"{e} is not finite")
-    return v
-
-
-# -- the size of an expression once expanded (the loader and the symbolic layer expand)
-class ObjectMemo:
-    """A memo keyed by the object itself (its ``id``), never by equality: two equal
-    expressions built separately share a hash, and comparing them walks both trees --
-    exponential for the walk's nested expressions.  Each entry keeps its object alive, so
-    an ``id`` is never reused while its entry exists."""
-
-    def __init__(self, size=200000):
-        self.entries, self.size = {}, size
-
-    def get(self, expr):
-        hit = self.entries.get(id(expr))
-        return None if hit is None else hit[1]
-
-    def put(self, expr, value):
-        if len(self.entries) > self.size:
-            self.entries.clear()
-        self.entries[id(expr)] = (expr, value)
-
-
-_TERMS_CACHE = ObjectMemo()
-
-
-def expanded_terms(expr):
-    """An upper estimate of the number of terms ``expand(expr)`` has (memoised)."""
-    if expr.is_Atom or isinstance(expr, sympy.Function):
-        return 1
-    n = _TERMS_CACHE.get(expr)
-    if n is None:
-        if expr.is_Add:
-            n = sum(expanded_terms(a) for a in expr.args)
-        elif expr.is_Mul:
-            n = 1
-            for a in expr.args:
-                n *= expanded_terms(a)
-        elif expr.is_Pow and expr.exp.is_Integer and expr.exp > 0:
-            b = expanded_terms(expr.base)
-            k = int(expr.exp)
-            n = math.comb(b + k - 1, k) if b > 1 else 1
-        else:
-            n = 1
-        n = min(n, 10**9)
-        _TERMS_CACHE.put(expr, n)
-    return n

@@ -64,6 +64,24 @@ def _vector3(value, what, element):
     return arr
 
 
+def square_matrix(value, n, element, expected, nonfinite, show=False):
+    """A finite ``n x n`` float array from ``n`` diagonal values or the matrix itself.
+    The errors say ``expected`` (what the value must be; ``show``: quoting a value that
+    is not numbers) and ``nonfinite`` (of an entry that is not finite)."""
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(f"{element}: {expected}" + (f", got {value!r}" if show else "")) \
+            from None
+    if arr.shape == (n,):
+        arr = np.diag(arr)
+    if arr.shape != (n, n):
+        raise ModelError(f"{element}: {expected}, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ModelError(f"{element}: {nonfinite}")
+    return arr
+
+
 def parse_axis(axis, element):
     """A unit vector from ``"x"``/``"-y"``/... or three numbers; refuses zero and non-finite."""
     if isinstance(axis, str):

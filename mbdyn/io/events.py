@@ -1,0 +1,65 @@
+"""The ``[[events]]`` of a model file: each condition read as a function of the state
+(``mbdyn.integrate.events``), its crossing direction from the comparison or the file,
+checked at the initial state.
+"""
+from __future__ import annotations
+
+import math
+import warnings
+
+from ..errors import ModelWarning
+from ..integrate.events import Event
+from ..integrate.events import sympy_condition as _condition
+from .expressions import ExpressionError, parse_condition
+from .keys import DIRECTIONS
+
+#: a crossing direction in words: 1 "rising", -1 "falling", 0 "either"
+WORDS = {number: word for word, number in DIRECTIONS.items()}
+
+
+def read_events(b, q0, u0):
+    """``(events, specs)``: the ``mb.Event``s of the builder ``b``'s document, and each as
+    the file wrote it (name, condition, terminal, direction)."""
+    model = b.model
+    events, specs = [], []
+    seen = set()
+    for path, e, name in b.entries("events", "event"):
+        if name in seen:
+            raise b.error(path + ("name",), f"a second event named {name!r}; event "
+                          "names must differ")
+        seen.add(name)
+        text = b.required(e, "condition", path, "event")
+        try:
+            g, implied = parse_condition(text, b.PTQ)
+        except ExpressionError as exc:
+            raise b.error(path + ("condition",), str(exc)) from None
+        explicit = e.get("direction")
+        if isinstance(explicit, str):
+            explicit = DIRECTIONS[explicit]
+        if explicit is not None and implied is not None and explicit != implied:
+            raise b.error(path + ("direction",), f"{WORDS[explicit]!r} contradicts the "
+                          f"condition {text!r}, which fires when it becomes true "
+                          f"({WORDS[implied]}); remove direction or write the condition "
+                          "the other way round")
+        direction = explicit if explicit is not None else (implied or 0)
+        g = g.subs({s: b.values[s.name] for s in g.free_symbols
+                    if s.name in b.values})
+        cond = _condition(g, model, text)
+        try:
+            g0 = cond(0.0, q0, u0)
+        except (ArithmeticError, ValueError, TypeError) as exc:
+            raise b.error(path + ("condition",), f"cannot be evaluated at the initial "
+                          f"state: {exc}") from None
+        if not math.isfinite(g0):
+            raise b.error(path + ("condition",), "is not finite at the initial state; "
+                          "check for divisions by zero")
+        holds = (g0 >= 0 and direction > 0) or (g0 <= 0 and direction < 0)
+        if holds:
+            warnings.warn(f"{b.file}: events[{path[1]}] ({name!r}): the condition {text!r} "
+                          "already holds at the initial state; the event fires only when "
+                          "it becomes true again", ModelWarning)
+        terminal = bool(e.get("terminal", False))
+        events.append(Event(name, cond, terminal, int(direction)))
+        specs.append({"name": name, "condition": text, "terminal": terminal,
+                      "direction": WORDS[direction]})
+    return events, specs

@@ -1,0 +1,68 @@
+"""The schema of a model file: its sections, the keys each may hold and the kind of value
+of each key (``mbdyn.io.value_checks`` checks a value of each kind).
+"""
+from __future__ import annotations
+
+# value kinds: "string", "name", "expr", "vector", "axis", "inertia", "orientation",
+# "names", "bool", "condition", "direction", "reactions", ("choice", options)
+MODEL_KEYS = {"name": "string", "description": "string", "gravity": "vector",
+              "default_case": "string"}
+BODY_KEYS = {"name": "name", "mass": "expr", "com": "vector", "inertia": "inertia",
+             "inertia_about": ("choice", ("com", "origin")), "shape": "shape"}
+SHAPE_KEYS = {"type": ("choice", ("sphere", "box", "cylinder", "disk", "rod")),
+              "radius": "expr", "length": "expr", "size": "vector", "center": "vector",
+              "start": "vector", "end": "vector", "axis": "axis", "color": "string"}
+JOINT_KINDS = ("revolute", "prismatic", "euler", "spherical", "fixed", "free")
+JOINT_KEYS = {"name": "name", "kind": ("choice", JOINT_KINDS), "parent": "name",
+              "child": "name", "axis": "axis", "position": "vector",
+              "orientation": "orientation", "sequence": "string", "coordinates": "names",
+              "speeds": "names", "drive": "expr"}
+LOAD_KEYS = {"name": "name", "body": "name", "force": "vector", "moment": "vector",
+             "point": "vector", "frame": ("choice", ("world", "body"))}
+SIMULATION_KEYS = {"t_end": "expr", "integrator": "string", "method": "string",
+                   "rtol": "expr", "atol": "expr", "dt": "expr", "max_step": "expr",
+                   "output_dt": "expr", "max_steps": "expr", "max_samples": "expr",
+                   "max_wall_time": "expr"}
+OUTPUT_KEYS = {"reactions": "reactions", "reactions_frame": ("choice", ("world", "child")),
+               "energy": "bool", "points": "points"}
+POINT_KEYS = {"frame": "name", "offset": "vector"}
+FORCE_KINDS = ("spring-damper", "joint-spring-damper", "bushing", "bearing", "contact")
+FORCE_KEYS = {"name": "name", "kind": ("choice", FORCE_KINDS),
+              "body_a": "name", "point_a": "vector", "body_b": "name", "point_b": "vector",
+              "body": "name", "point": "vector", "housing": "name", "center": "vector",
+              "joint": "name", "axis": "axis", "stiffness": "matrix6", "damping": "matrix6",
+              "free_length": "expr", "preload": "expr", "rest": "expr", "min_length": "expr",
+              "force_table": "table", "damping_table": "table", "law": "expr",
+              "interpolation": ("choice", ("pchip", "linear")),
+              "speed": "name", "speeds": "exprs",
+              "kxx": "coefficient", "kxy": "coefficient", "kyx": "coefficient",
+              "kyy": "coefficient", "cxx": "coefficient", "cxy": "coefficient",
+              "cyx": "coefficient", "cyy": "coefficient",
+              "radius": "expr", "shape": ("choice", ("sphere", "disk")),
+              "plane_point": "vector", "plane_normal": "axis", "exponent": "expr",
+              "restitution": "expr", "impact_speed": "expr", "friction": "expr",
+              "slip_speed": "expr"}
+EFFECT_KEYS = {"gravity": "bool", "gyroscopic": "bool", "off": "names", "on": "names"}
+EVENT_KEYS = {"name": "name", "condition": "condition", "terminal": "bool",
+              "direction": "direction"}
+
+#: section -> (layout, keys): "table" (fixed keys), "map" (any names -> expr),
+#: "array" (array of tables with a name each)
+SECTIONS = {
+    "model": ("table", MODEL_KEYS),
+    "parameters": ("map", None),
+    "bodies": ("array", BODY_KEYS),
+    "joints": ("array", JOINT_KEYS),
+    "loads": ("array", LOAD_KEYS),
+    "forces": ("array", FORCE_KEYS),
+    "effects": ("table", EFFECT_KEYS),
+    "initial": ("map", None),
+    "initial_speeds": ("map", None),
+    "simulation": ("table", SIMULATION_KEYS),
+    "outputs": ("table", OUTPUT_KEYS),
+    "events": ("array", EVENT_KEYS),
+    "cases": ("cases", None),
+}
+ARRAY_ELEMENT = {"bodies": "body", "joints": "joint", "loads": "load", "forces": "force",
+                 "events": "event"}
+DIRECTIONS = {"rising": 1, "falling": -1, "either": 0}
