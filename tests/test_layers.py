@@ -34,8 +34,8 @@ LAZY_UPWARD = {
     # Result.plot / Result.animate: thin methods, matplotlib and plotly load on call
     ("mbdyn.integrate.result", "mbdyn.viz"),
     # a sweep member is a model file: its worker reads it with the loader
-    ("mbdyn.analysis.sweep", "mbdyn.io.loader"),
-    ("mbdyn.analysis.sweep", "mbdyn.io.schema"),
+    ("mbdyn.analysis.sweeps.model_file", "mbdyn.io.loader"),
+    ("mbdyn.analysis.sweeps.grid", "mbdyn.io.schema"),
 }
 
 

@@ -14,6 +14,12 @@ import numpy as np
 from ..errors import ModelError
 
 
+def brief(value, width=40):
+    """``repr(value)``, shortened to ``width`` characters for a message."""
+    text = repr(value)
+    return text if len(text) <= width else text[:width - 3] + "..."
+
+
 def model(value, where):
     """A compiled ``Model``."""
     from ..compiled.model import Model

@@ -181,6 +181,21 @@ def campbell(scene, parameter, values, orders=(1,), whirl=(), at="equilibrium",
     ``progress``: a callable ``progress(done, total)`` called after each value (``mbdyn
     campbell`` passes ``cli.common.Estimate``: the time the diagram will take, on stderr).
     """
+    orders, whirl, fixed = _checked(parameter, orders, whirl, at, fixed, progress)
+    build = _builder(scene, parameter)
+    values = _values(values)
+    rows = _modes_at_each(build, parameter, values, whirl, at, fixed, spin_is_parameter,
+                          progress)
+    order, macs = _track(rows)
+    freq, real, zeta, whirls = _tracked(rows, order)
+    critical, onset = _crossings_of(values, freq, real, orders, spin_is_parameter)
+    return Campbell(parameter, values, freq, real, zeta, whirls, np.array(macs),
+                    critical, onset, spin_is_parameter)
+
+
+def _checked(parameter, orders, whirl, at, fixed, progress):
+    """``orders``, ``whirl`` and ``fixed`` checked (``at``, ``parameter`` and ``progress``
+    too)."""
     if not isinstance(at, str) or at not in ("equilibrium", "initial"):
         raise ModelError(f"campbell: at must be 'equilibrium' or 'initial', got {at!r}")
     if not isinstance(parameter, str):
@@ -194,13 +209,23 @@ def campbell(scene, parameter, values, orders=(1,), whirl=(), at="equilibrium",
     if progress is not None and not callable(progress):
         raise ModelError(f"campbell: progress must be a function (done, total), got "
                          f"{progress!r}")
-    build = _builder(scene, parameter)
+    return orders, whirl, fixed
+
+
+def _values(values):
+    """The parameter values as a finite 1-D array of two or more."""
     try:
         values = np.asarray(values, dtype=float)
     except (TypeError, ValueError):
         raise ModelError(f"campbell: values must be numbers, got {values!r}") from None
     if values.ndim != 1 or len(values) < 2 or not np.all(np.isfinite(values)):
         raise ModelError("campbell: give at least two finite parameter values")
+    return values
+
+
+def _modes_at_each(build, parameter, values, whirl, at, fixed, spin_is_parameter, progress):
+    """The ``Modes`` at each value: the model built, its equilibrium found (warm-started
+    from the previous value's) or its initial configuration, linearised."""
     guess = None
     rows = []
     for i, v in enumerate(values):
@@ -218,8 +243,15 @@ def campbell(scene, parameter, values, orders=(1,), whirl=(), at="equilibrium",
         rows.append(compute_modes(lin, whirl=whirl, spin=sign))
         if progress is not None:
             progress(i + 1, len(values))
+    return rows
+
+
+def _track(rows):
+    """``order``: for each value, the indices of its modes in the order of the first
+    value's (assigned to those of the previous value by MAC); ``macs``: the MAC of each
+    assignment."""
+    from scipy.optimize import linear_sum_assignment
     n = min(len(r.modes) for r in rows)
-    # track: assign the modes of each step to those of the previous by MAC
     order = [list(range(n))]
     macs = []
     for i in range(1, len(rows)):
@@ -231,11 +263,16 @@ def campbell(scene, parameter, values, orders=(1,), whirl=(), at="equilibrium",
         fp = np.array([[p.damped_frequency for _ in cur[:score.shape[1]]] for p in prev])
         fc = np.array([[c.damped_frequency for c in cur[:score.shape[1]]] for _ in prev])
         cost = -(score - 1e-3 * np.abs(fp - fc) / (np.abs(fp) + np.abs(fc) + 1e-300))
-        from scipy.optimize import linear_sum_assignment
         r_, c_ = linear_sum_assignment(cost)
         assigned = [int(c) for _, c in sorted(zip(r_, c_))]
         order.append(assigned)
         macs.append([score[a, b] for a, b in zip(range(n), assigned)])
+    return order, macs
+
+
+def _tracked(rows, order):
+    """Damped frequency, real part, damping ratio (arrays: value x tracked mode) and
+    whirl (lists) of the tracked modes."""
     freq = np.array([[rows[i].modes[j].damped_frequency for j in order[i]]
                      for i in range(len(rows))])
     real = np.array([[rows[i].modes[j].eigenvalue.real for j in order[i]]
@@ -243,8 +280,15 @@ def campbell(scene, parameter, values, orders=(1,), whirl=(), at="equilibrium",
     zeta = np.array([[rows[i].modes[j].damping_ratio for j in order[i]]
                      for i in range(len(rows))])
     whirls = [[rows[i].modes[j].whirl for j in order[i]] for i in range(len(rows))]
+    return freq, real, zeta, whirls
+
+
+def _crossings_of(values, freq, real, orders, spin_is_parameter):
+    """``critical``: ``(mode, order, value)`` where a mode's frequency meets a spin line
+    (where it oscillates on both sides); ``onset``: ``(mode, value)`` where its real part
+    crosses zero; both sorted by value."""
     critical, onset = [], []
-    for k in range(n):
+    for k in range(freq.shape[1]):
         if spin_is_parameter:
             oscillating = freq[:, k] > 0
             for o in orders:
@@ -257,5 +301,4 @@ def campbell(scene, parameter, values, orders=(1,), whirl=(), at="equilibrium",
             onset.append((k, v))
     critical.sort(key=lambda c: c[2])
     onset.sort(key=lambda c: c[1])
-    return Campbell(parameter, values, freq, real, zeta, whirls, np.array(macs),
-                    critical, onset, spin_is_parameter)
+    return critical, onset

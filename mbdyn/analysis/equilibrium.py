@@ -69,6 +69,34 @@ def _unknowns(model, tangent, fixed):
     return [k for k in range(tangent.n) if k not in held]
 
 
+class _Equations:
+    """The equations left free, ``f(q, u, t)[free] = 0``, as functions of the free tangent
+    coordinates ``x`` about the guess: their residual, Jacobian and configuration."""
+
+    def __init__(self, model, tangent, free, u, t):
+        self.model, self.tangent, self.free, self.u, self.t = model, tangent, free, u, t
+
+    def residual(self, x_free):
+        return self.model.forcing(self.configuration(x_free), self.u, self.t)[self.free]
+
+    def jacobian(self, x_free):
+        """Central differences of the residual."""
+        h = np.cbrt(np.finfo(float).eps)
+        n = len(self.free)
+        J = np.empty((n, n))
+        for j in range(n):
+            e = np.zeros(n)
+            e[j] = h
+            J[:, j] = (self.residual(x_free + e) - self.residual(x_free - e)) / (2 * h)
+        return J
+
+    def configuration(self, x_free):
+        """The coordinates ``q`` at the free tangent coordinates ``x_free``."""
+        x = np.zeros(self.tangent.n)
+        x[self.free] = x_free
+        return self.tangent.retract(x)
+
+
 def equilibrium(model, q_guess=None, u=None, t=0.0, fixed=(), tol=1e-10, max_iter=50):
     """An equilibrium of ``model`` near ``q_guess`` (array or ``{name: value}``; default
     the zero configuration) at speeds ``u`` (default zero) and time ``t``.
@@ -77,6 +105,34 @@ def equilibrium(model, q_guess=None, u=None, t=0.0, fixed=(), tol=1e-10, max_ite
     angle of a rotor; their equations are left out too.  ``tol``: on the residual
     ``|f|`` relative to the size of the forces at the guess.
     """
+    model, q0, u, t, tol, max_iter, fixed = _checked(model, q_guess, u, t, fixed, tol,
+                                                     max_iter)
+    tangent = Tangent(model, q0)
+    free = _unknowns(model, tangent, fixed)
+    if not free:
+        raise ModelError("equilibrium: every coordinate is held fixed; nothing to solve")
+    eqs = _Equations(model, tangent, free, u, t)
+    x = np.zeros(len(free))
+    r = eqs.residual(x)
+    scale = _force_scale(model, q0, u, t, r)
+    x, r, iterations, cond = _newton(eqs, x, r, tol, scale, max_iter)
+    method = "newton"
+    if np.abs(r).max() > tol * scale:
+        method = "scipy.optimize.root (hybr)"
+        x, r, iterations, cond = _fallback(eqs, x, r, tol, scale, iterations)
+    q = eqs.configuration(x)
+    model.normalize_quaternions(q)
+    _warn_if_singular(model, q)
+    # the equations at other times: do they still vanish (a relative equilibrium)?
+    later = [model.forcing(q, u, t + dt)[free] for dt in (0.37, 1.3, 4.1)]
+    time_dependent = bool(max(np.abs(f).max() for f in later) > 1e3 * tol * scale)
+    return Equilibrium(model, q, u, float(t), float(np.abs(r).max()), iterations, cond,
+                       method, time_dependent)
+
+
+def _checked(model, q_guess, u, t, fixed, tol, max_iter):
+    """The arguments checked (in this order) and the guess as vectors, finite, its
+    quaternions normalised."""
     where = "equilibrium"
     model = arguments.model(model, where)
     t = arguments.number(t, where, "t")
@@ -90,74 +146,73 @@ def equilibrium(model, q_guess=None, u=None, t=0.0, fixed=(), tol=1e-10, max_ite
     if not (np.all(np.isfinite(q0)) and np.all(np.isfinite(u))):
         raise ModelError("equilibrium: the guess holds non-finite values")
     model.normalize_quaternions(q0)
-    tangent = Tangent(model, q0)
-    free = _unknowns(model, tangent, fixed)
-    if not free:
-        raise ModelError("equilibrium: every coordinate is held fixed; nothing to solve")
+    return model, q0, u, t, tol, max_iter, fixed
 
-    def residual(x_free):
-        x = np.zeros(tangent.n)
-        x[free] = x_free
-        return model.forcing(tangent.retract(x), u, t)[free]
 
-    def jacobian(x_free, r0):
-        h = np.cbrt(np.finfo(float).eps)
-        J = np.empty((len(free), len(free)))
-        for j in range(len(free)):
-            e = np.zeros(len(free))
-            e[j] = h
-            J[:, j] = (residual(x_free + e) - residual(x_free - e)) / (2 * h)
-        return J
-
-    x = np.zeros(len(free))
-    r = residual(x)
+def _force_scale(model, q0, u, t, r):
+    """The size of the forces at the guess, which ``tol`` is relative to; non-finite
+    forces are refused."""
     scale = max(np.abs(r).max(), np.abs(model.forcing(q0, u, t)).max(),
                 np.abs(np.diag(model.mass_matrix(q0, t))).max() * 9.81, 1e-300)
     if not (np.all(np.isfinite(r)) and np.isfinite(scale)):
         raise ModelError(f"equilibrium: the generalized forces of model {model.name!r} are "
                          f"not finite at the guess (t = {t:g}); check the speeds u and the "
                          "time t")
-    iterations, method, cond = 0, "newton", np.inf
+    return scale
+
+
+def _newton(eqs, x, r, tol, scale, max_iter):
+    """Newton-Raphson with a backtracking line search on ``|f|``, from ``x`` (residual
+    ``r``); stops where a step no longer lowers ``|f|``.  Returns ``x``, its residual, the
+    iterations and the last Jacobian's condition number."""
+    iterations, cond = 0, np.inf
     while np.abs(r).max() > tol * scale and iterations < max_iter:
         iterations += 1
-        J = jacobian(x, r)
+        J = eqs.jacobian(x)
         cond = float(np.linalg.cond(J))
         try:
             dx = np.linalg.solve(J, -r)
         except np.linalg.LinAlgError:
             break
-        lam, norm0 = 1.0, np.linalg.norm(r)
-        while lam > 1e-6:                      # backtracking line search on |f|
-            trial = residual(x + lam * dx)
-            if np.all(np.isfinite(trial)) and np.linalg.norm(trial) < (1 - 1e-4 * lam) * norm0:
-                break
-            lam *= 0.5
+        lam = _step_length(eqs, x, dx, np.linalg.norm(r))
         if lam <= 1e-6:
             break
         x = x + lam * dx
-        r = residual(x)
-    if np.abs(r).max() > tol * scale:
-        from scipy.optimize import root
-        sol = root(residual, x, method="hybr", options={"xtol": 1e-14})
-        method = "scipy.optimize.root (hybr)"
-        if np.all(np.isfinite(sol.x)) and np.abs(residual(sol.x)).max() <= tol * scale:
-            x, r = sol.x, residual(sol.x)
-            cond = float(np.linalg.cond(jacobian(x, r)))
-            iterations += int(sol.nfev)
-        else:
-            xf = np.zeros(tangent.n)
-            xf[free] = x
-            last = tangent.retract(xf)
-            raise EquilibriumError(
-                f"model {model.name!r}: no equilibrium found from the guess (residual "
-                f"{np.abs(r).max():.3g} after {iterations} Newton iterations and the "
-                f"fallback); try another guess, hold cyclic coordinates fixed, or check "
-                "that the model can rest (a spinning body needs its spin speed in u)",
-                last=last, residual=float(np.abs(r).max()))
-    xf = np.zeros(tangent.n)
-    xf[free] = x
-    q = tangent.retract(xf)
-    model.normalize_quaternions(q)
+        r = eqs.residual(x)
+    return x, r, iterations, cond
+
+
+def _step_length(eqs, x, dx, norm0):
+    """The backtracking line search on ``|f|``: the first of 1, 1/2, 1/4 ... that lowers
+    it enough (``<= 1e-6``: none did)."""
+    lam = 1.0
+    while lam > 1e-6:
+        trial = eqs.residual(x + lam * dx)
+        if np.all(np.isfinite(trial)) and np.linalg.norm(trial) < (1 - 1e-4 * lam) * norm0:
+            break
+        lam *= 0.5
+    return lam
+
+
+def _fallback(eqs, x, r, tol, scale, iterations):
+    """``scipy.optimize.root`` from where Newton stopped (``x``, residual ``r``, after
+    ``iterations``); an ``EquilibriumError`` with Newton's last iterate if it fails too."""
+    from scipy.optimize import root
+    sol = root(eqs.residual, x, method="hybr", options={"xtol": 1e-14})
+    if np.all(np.isfinite(sol.x)) and np.abs(eqs.residual(sol.x)).max() <= tol * scale:
+        x, r = sol.x, eqs.residual(sol.x)
+        return x, r, iterations + int(sol.nfev), float(np.linalg.cond(eqs.jacobian(x)))
+    raise EquilibriumError(
+        f"model {eqs.model.name!r}: no equilibrium found from the guess (residual "
+        f"{np.abs(r).max():.3g} after {iterations} Newton iterations and the "
+        f"fallback); try another guess, hold cyclic coordinates fixed, or check "
+        "that the model can rest (a spinning body needs its spin speed in u)",
+        last=eqs.configuration(x), residual=float(np.abs(r).max()))
+
+
+def _warn_if_singular(model, q):
+    """A ``SingularityWarning`` (at the caller of ``equilibrium``) if ``q`` puts Euler
+    angles at their singular configuration."""
     near = {j: d for j, d in model.euler_singularity(q).items() if d < 1e-6}
     if near:
         import warnings
@@ -166,9 +221,4 @@ def equilibrium(model, q_guess=None, u=None, t=0.0, fixed=(), tol=1e-10, max_ite
         warnings.warn(f"model {model.name!r}: the equilibrium found puts the Euler angles of "
                       f"{', '.join(near)} at their singular configuration; the angle rates and "
                       "the mass matrix are singular there -- try another guess, or a "
-                      "spherical joint", SingularityWarning, stacklevel=2)
-    # the equations at other times: do they still vanish (a relative equilibrium)?
-    later = [model.forcing(q, u, t + dt)[free] for dt in (0.37, 1.3, 4.1)]
-    time_dependent = bool(max(np.abs(f).max() for f in later) > 1e3 * tol * scale)
-    return Equilibrium(model, q, u, float(t), float(np.abs(r).max()), iterations, cond,
-                       method, time_dependent)
+                      "spherical joint", SingularityWarning, stacklevel=3)

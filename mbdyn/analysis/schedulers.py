@@ -31,6 +31,7 @@ import time
 
 from .. import limits
 from ..errors import ModelError
+from .arguments import brief
 
 
 NAMES = ("serial", "processes", "dask")
@@ -62,7 +63,7 @@ def check_spec(spec):
         if callable(getattr(spec, "map_unordered", None)) and callable(
                 getattr(spec, "close", None)):
             return
-        raise ModelError(f"scheduler={_brief(spec)}: not a scheduler; give 'serial', "
+        raise ModelError(f"scheduler={brief(spec)}: not a scheduler; give 'serial', "
                          "'processes', 'dask', 'tcp://HOST:PORT' (an existing Dask "
                          "scheduler) or an object with map_unordered(fn, tasks) and close()")
     if spec in NAMES:
@@ -70,14 +71,8 @@ def check_spec(spec):
     if spec.startswith("tcp://"):
         parse_address(spec)
         return
-    raise ModelError(f"unknown scheduler {_brief(spec)}; use serial, processes, dask or "
+    raise ModelError(f"unknown scheduler {brief(spec)}; use serial, processes, dask or "
                      "tcp://HOST:PORT (an existing Dask scheduler)")
-
-
-def _brief(value, width=40):
-    """``repr(value)``, shortened to ``width`` characters for a message."""
-    text = repr(value)
-    return text if len(text) <= width else text[:width - 3] + "..."
 
 
 def _cores():
@@ -154,11 +149,11 @@ def parse_address(spec):
     IPv4 address or ``[IPv6]``, PORT 1..65535); ``ModelError`` naming what is wrong."""
     m = _ADDRESS.fullmatch(spec)
     if not m:
-        raise ModelError(f"scheduler {_brief(spec)}: not an address tcp://HOST:PORT; write "
+        raise ModelError(f"scheduler {brief(spec)}: not an address tcp://HOST:PORT; write "
                          "e.g. tcp://127.0.0.1:8786 (a host name or address, a port number)")
     host, port = m.group("host") or m.group("ipv6"), m.group("port")
     if not (port.isascii() and port.isdigit()) or not 1 <= int(port) <= 65535:
-        raise ModelError(f"scheduler {_brief(spec)}: the port {_brief(port)} is not a whole "
+        raise ModelError(f"scheduler {brief(spec)}: the port {brief(port)} is not a whole "
                          "number from 1 to 65535; write e.g. tcp://127.0.0.1:8786")
     return host, int(port)
 
@@ -292,7 +287,7 @@ class DaskScheduler:
             raise
         except Exception as exc:           # garbage from the peer: any error, even memory
             raise ModelError(f"cannot use the Dask scheduler at {self.address}: "
-                             f"{type(exc).__name__}: {_brief(str(exc), 120)}; is it a Dask "
+                             f"{type(exc).__name__}: {brief(str(exc), 120)}; is it a Dask "
                              "scheduler of a compatible version?") from None
 
     def map_unordered(self, fn, tasks):

@@ -2,7 +2,7 @@
 
 Each command is a submodule ``mbdyn.cli.NAME`` listed in ``COMMANDS`` with a
 ``register(subparsers)`` function that adds its parser and sets ``func`` (called with the
-parsed arguments, returns the exit code).  To add a command, write the module and append
+parsed arguments, returns the exit code); ``common.add_command`` makes that parser.  To add a command, write the module and append
 its name to ``COMMANDS`` and its one-line help to ``SUMMARIES``.  Only the module of the
 command that runs is imported.
 

@@ -5,23 +5,20 @@ import json
 import math
 import sys
 
-from . import SUMMARIES
 from ..analysis.accuracy import DEFAULT_INTEGRATORS, TOLERANCES, accuracy_study
 from ..errors import ModelError
 from ..escape import legend_label, mathtext
 from ..files import check_target, replacing
 from ..integrate.settings import INTEGRATORS
-from .common import add_model_arguments, load, positive, positive_int
+from .common import add_command, load, positive, positive_int
 
 
 def register(subparsers):
-    p = subparsers.add_parser(
-        "accuracy", help=SUMMARIES["accuracy"],
-        description="Integrate the model with a reference (DOP853 at 1e-13, cross-checked by "
+    p = add_command(subparsers, "accuracy",
+                    "Integrate the model with a reference (DOP853 at 1e-13, cross-checked by "
                     "Radau), then with each integrator over a sweep of tolerances (adaptive) "
                     "or step sizes (fixed-step); report error (max over time), energy drift, "
-                    "wall time and right-hand-side evaluations.")
-    add_model_arguments(p)
+                    "wall time and right-hand-side evaluations.", run)
     p.add_argument("--t-end", metavar="T", type=positive,
                    help="end time (s; default the file's simulation.t_end)")
     p.add_argument("--integrators", metavar="LIST",
@@ -42,7 +39,6 @@ def register(subparsers):
     p.add_argument("--plot", metavar="FILE",
                    help="write a log-log work-precision diagram (error against wall time; "
                         "needs matplotlib)")
-    p.set_defaults(func=run)
 
 
 def _floats(text, what):

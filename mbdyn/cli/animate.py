@@ -8,24 +8,21 @@ from __future__ import annotations
 import os
 import sys
 
-from . import SUMMARIES
-from .common import add_model_arguments, load, positive, Progress
+from .common import Progress, add_command, default_output, load, positive, title
 
 
 def register(subparsers):
-    p = subparsers.add_parser(
-        "animate", help=SUMMARIES["animate"],
-        description="Simulate the model with its [simulation] settings and write an "
+    p = add_command(subparsers, "animate",
+                    "Simulate the model with its [simulation] settings and write an "
                     "animation: real-time playback (--speed to change), bodies with their "
                     "shapes, trails of the centres of mass, the time shown.  .html is one "
-                    "file that opens offline, with orbit/zoom, play/pause and a time slider.")
-    add_model_arguments(p)
+                    "file that opens offline, with orbit/zoom, play/pause and a time slider.",
+                    run)
     p.add_argument("--out", metavar="FILE", help=".gif, .mp4 (needs the video extra) or "
                                                  ".html (default STEM.gif)")
     p.add_argument("--speed", type=positive, default=1.0, help="playback speed (default 1: "
                                                             "real time)")
     p.add_argument("--fps", type=positive, default=30.0, help="frames per second (default 30)")
-    p.set_defaults(func=run)
 
 
 def run(args):
@@ -33,13 +30,11 @@ def run(args):
     if args.out:
         check_output(args.out)         # before the run: a bad request costs nothing
     scene = load(args)
-    out = args.out or os.path.splitext(os.path.basename(scene.path))[0] + (
-        f"_{scene.case}" if scene.case else "") + ".gif"
+    out = args.out or default_output(scene, ".gif")
     check_output(out)
     progress = Progress(scene.settings.get("t_end") or 0.0)
     result = scene.simulate(progress=progress)
     progress.close()
-    n = animate(result, out, speed=args.speed, fps=args.fps,
-                title=f"{scene.name}{' (case ' + scene.case + ')' if scene.case else ''}")
+    n = animate(result, out, speed=args.speed, fps=args.fps, title=title(scene))
     sys.stdout.write(f"wrote {out} ({n} frames, {os.path.getsize(out) / 1e6:.2f} MB)\n")
     return 0

@@ -7,20 +7,16 @@
 """
 from __future__ import annotations
 
-import json
 import sys
 
-from . import SUMMARIES
-from .common import Estimate, add_model_arguments, load
+from .common import Estimate, add_command, load, print_json
 from .vibration_args import add_vibration_arguments, names, value_range, whirl_pairs
 
 
 def register(subparsers):
-    p = subparsers.add_parser(
-        "campbell", help=SUMMARIES["campbell"],
-        description="Equilibrium, linearisation and modes at each value of a parameter; modes "
-                    "tracked by shape (MAC); critical speeds and the onset of instability.")
-    add_model_arguments(p)
+    p = add_command(subparsers, "campbell",
+                    "Equilibrium, linearisation and modes at each value of a parameter; modes "
+                    "tracked by shape (MAC); critical speeds and the onset of instability.", run)
     p.add_argument("--parameter", required=True, metavar="NAME",
                    help="a name in the file's [parameters], e.g. Omega")
     p.add_argument("--values", required=True, metavar="START:STOP:N",
@@ -33,7 +29,6 @@ def register(subparsers):
                         "speeds)")
     p.add_argument("--plot", metavar="FILE", help="write the diagram (.png, .pdf, .svg)")
     add_vibration_arguments(p)
-    p.set_defaults(func=run)
 
 
 def run(args):
@@ -59,8 +54,7 @@ def run(args):
     if args.plot:
         cb.plot(args.plot, orders=orders)
     if args.json:
-        sys.stdout.write(json.dumps({"model": scene.name, "case": scene.case,
-                                     "campbell": cb.to_dict()}) + "\n")
+        print_json(scene, {"campbell": cb.to_dict()})
         return 0
     sys.stdout.write(f"{scene.name}: modes against {args.parameter}\n{cb.table()}\n")
     if args.plot:

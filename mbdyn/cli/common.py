@@ -2,11 +2,14 @@
 from __future__ import annotations
 
 import argparse
+import json
 import math
+import os
 import sys
 import time
 import warnings
 
+from . import SUMMARIES
 from ..io.errors import ModelFileError
 from ..io.loader import load_model
 from ..io.schema import parse_set_value
@@ -40,6 +43,17 @@ def positive_int(text):
     if v < 1:
         raise argparse.ArgumentTypeError(f"{text!r} is not >= 1")
     return v
+
+
+def add_command(subparsers, name, description, func, model_arguments=True):
+    """The parser of the command ``name``: its one-line help from ``SUMMARIES``, its
+    ``description``, ``MODEL [--case NAME] [--set PATH=VALUE ...] [--effects LIST]``
+    unless ``model_arguments`` is false; ``func(args)`` runs it."""
+    p = subparsers.add_parser(name, help=SUMMARIES[name], description=description)
+    if model_arguments:
+        add_model_arguments(p)
+    p.set_defaults(func=func)
+    return p
 
 
 def add_model_arguments(parser):
@@ -84,6 +98,28 @@ def load(args, flags=(), record_warnings=False):
                               effects=effects)
     return load_model(args.model, case=args.case, overrides=overrides(args, flags),
                       effects=effects)
+
+
+def heading(scene):
+    """``NAME (PATH, case CASE)``: the first line of a command's report."""
+    return f"{scene.name} ({scene.path}{', case ' + scene.case if scene.case else ''})"
+
+
+def title(scene):
+    """``NAME (case CASE)``: a picture's title."""
+    return f"{scene.name}{' (case ' + scene.case + ')' if scene.case else ''}"
+
+
+def default_output(scene, suffix):
+    """``STEM_CASE.SUFFIX`` (``STEM.SUFFIX`` without a case) in the current directory: where
+    a picture or an animation goes when no path is given."""
+    return os.path.splitext(os.path.basename(scene.path))[0] + (
+        f"_{scene.case}" if scene.case else "") + suffix
+
+
+def print_json(scene, fields):
+    """One JSON object on stdout: the model's name and case, then ``fields``."""
+    sys.stdout.write(json.dumps({"model": scene.name, "case": scene.case, **fields}) + "\n")
 
 
 def fmt(x):

@@ -18,7 +18,6 @@ from __future__ import annotations
 import json
 import sys
 
-from . import SUMMARIES
 from .. import limits
 from ..symbolic.derive import derive
 from ..symbolic.methods import METHODS
@@ -29,16 +28,13 @@ FORMATS = ("text", "latex", "markdown", "json")
 
 
 def register(subparsers):
-    from .common import add_model_arguments
-    p = subparsers.add_parser(
-        "eom", help=SUMMARIES["eom"],
-        description="Derive a model's equations of motion with sympy by Newton-Euler (with "
+    from .common import add_command
+    p = add_command(subparsers, "eom",
+                    "Derive a model's equations of motion with sympy by Newton-Euler (with "
                     "the joint reactions), Newton-Euler-Jourdain or Lagrange; print them, "
                     "optionally with the textbook's derivation steps and solved for the "
-                    "accelerations and reactions.")
-    add_model_arguments(p)
+                    "accelerations and reactions.", eom)
     add_eom_arguments(p)
-    p.set_defaults(func=eom)
 
 
 def add_eom_arguments(p):

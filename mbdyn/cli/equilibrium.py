@@ -5,23 +5,18 @@
 """
 from __future__ import annotations
 
-import json
 import sys
 
-from . import SUMMARIES
-from .common import add_model_arguments, fmt, load
+from .common import add_command, fmt, heading, load, print_json
 from .vibration_args import add_vibration_arguments, names
 
 
 def register(subparsers):
-    p = subparsers.add_parser(
-        "equilibrium", help=SUMMARIES["equilibrium"],
-        description="Find the configuration where the generalized forces vanish at the "
+    p = add_command(subparsers, "equilibrium",
+                    "Find the configuration where the generalized forces vanish at the "
                     "initial speeds (zero unless the file gives spin speeds), starting from "
-                    "the initial coordinates.")
-    add_model_arguments(p)
+                    "the initial coordinates.", run)
     add_vibration_arguments(p, whirl=False)
-    p.set_defaults(func=run)
 
 
 def run(args):
@@ -29,11 +24,10 @@ def run(args):
     scene = load(args)
     eq = equilibrium(scene.model, scene.q0, scene.u0, t=args.t, fixed=names(args.fixed))
     if args.json:
-        sys.stdout.write(json.dumps({"model": scene.name, "case": scene.case,
-                                     "equilibrium": eq.to_dict()}) + "\n")
+        print_json(scene, {"equilibrium": eq.to_dict()})
         return 0
     w = sys.stdout.write
-    w(f"{scene.name} ({scene.path}{', case ' + scene.case if scene.case else ''})\n")
+    w(heading(scene) + "\n")
     w(f"  equilibrium by {eq.method}: {eq.iterations} iterations, residual "
       f"{fmt(eq.residual)}, Jacobian condition {fmt(eq.condition)}\n")
     if eq.time_dependent:

@@ -4,23 +4,18 @@ from __future__ import annotations
 
 import json
 import sys
-import warnings
 
 import numpy as np
 
-from . import SUMMARIES
 from ..io.results import outputs_spec
-from .common import add_model_arguments, fmt, load
+from .common import add_command, fmt, load
 
 
 def register(subparsers):
-    p = subparsers.add_parser(
-        "info", help=SUMMARIES["info"],
-        description="Describe a model file: bodies, joints, coordinates, speeds, degrees "
-                    "of freedom, drives, loads, events and every validation warning.")
-    add_model_arguments(p)
+    p = add_command(subparsers, "info", "Describe a model file: bodies, joints, coordinates, "
+                    "speeds, degrees of freedom, drives, loads, events and every validation "
+                    "warning.", info)
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.set_defaults(func=info)
 
 
 def _text(v):
@@ -83,14 +78,19 @@ def describe(scene):
 
 
 def info(args):
-    with warnings.catch_warnings(record=True):      # listed in the report, not on stderr
-        warnings.simplefilter("always")
-        scene = load(args)
+    scene = load(args, record_warnings=True)      # listed in the report, not on stderr
     d = describe(scene)
     if args.json:
         sys.stdout.write(json.dumps(d) + "\n")
         return 0
     w = sys.stdout.write
+    for section in (_model, _bodies, _joints, _states, _loads, _run_settings, _outputs):
+        section(d, w)
+    return 0
+
+
+def _model(d, w):
+    """The model, its file and description, its cases, parameters and gravity."""
     w(f"model        {d['model']}  ({d['file']})\n")
     if d["description"]:
         w(f"             {d['description']}\n")
@@ -101,16 +101,22 @@ def info(args):
         w("parameters   " + ", ".join(f"{k} = {fmt(v)}" for k, v in d["parameters"].items())
           + "\n")
     w(f"gravity      {_text(d['gravity'])}\n")
+
+
+def _bodies(d, w):
     w(f"bodies ({len(d['bodies'])})\n")
     for b in d["bodies"]:
         if b["massless"]:
             w(f"  {b['name']:<14} massless frame\n")
             continue
-        I = np.array(b["inertia"])
+        I = np.array(b["inertia"])      # noqa: E741  (the inertia tensor's usual name)
         inertia = (f"diag{_text(np.diag(I).tolist())}" if not np.any(I - np.diag(np.diag(I)))
                    else _text(I.tolist()))
         w(f"  {b['name']:<14} mass {fmt(b['mass'])}, com {_text(b['com'])}, "
           f"inertia about com {inertia}\n")
+
+
+def _joints(d, w):
     w(f"joints ({len(d['joints'])})\n")
     for j in d["joints"]:
         extra = ""
@@ -126,11 +132,19 @@ def info(args):
                 else ("coordinates " + ", ".join(j["coordinates"]) if j["coordinates"]
                       else "no coordinates"))
         w(f"  {j['name']:<14} {j['kind']}{extra}, {j['parent']} -> {j['child']}; {what}\n")
+
+
+def _states(d, w):
+    """Coordinates, speeds, degrees of freedom and drives."""
     w(f"coordinates  {', '.join(d['coordinates']) or '(none)'}\n")
     w(f"speeds       {', '.join(d['speeds']) or '(none)'}\n")
     w(f"degrees of freedom  {d['dof']}\n")
     w("drives       " + ("; ".join(f"{x['joint']}: {x['coordinate']} = {x['expression']}"
                                    for x in d["drives"]) or "none") + "\n")
+
+
+def _loads(d, w):
+    """Point loads, force elements and the effects switched on or off."""
     w(f"loads ({len(d['loads'])})\n")
     for ld in d["loads"]:
         parts = [f"{k} {_text(ld[k])}" for k in ("force", "moment") if ld[k] is not None]
@@ -141,6 +155,10 @@ def info(args):
           f"{'' if fe['on'] else '  [off]'}\n")
     w("effects      " + ", ".join(f"{k} {'on' if on else 'OFF'}"
                                   for k, on in d["effects"].items()) + "\n")
+
+
+def _run_settings(d, w):
+    """Events, the initial state and the simulation settings."""
     w(f"events ({len(d['events'])})\n")
     for e in d["events"]:
         w(f"  {e['name']:<14} {e['condition']}  ({e['direction']}"
@@ -150,6 +168,10 @@ def info(args):
     s = d["simulation"]
     w("simulation   " + ", ".join(f"{k} = {fmt(v) if not isinstance(v, str) else v}"
                                   for k, v in s.items() if v is not None) + "\n")
+
+
+def _outputs(d, w):
+    """The outputs the file asks for, and the validation warnings."""
     o = d["outputs"]
     outs = []
     if o["reactions"]:
@@ -162,4 +184,3 @@ def info(args):
     w(f"warnings ({len(d['warnings'])})\n")
     for text in d["warnings"]:
         w(f"  - {text}\n")
-    return 0

@@ -6,20 +6,16 @@
 """
 from __future__ import annotations
 
-import json
 import sys
 
-from . import SUMMARIES
-from .common import add_model_arguments, load, positive, positive_int
+from .common import add_command, heading, load, positive, positive_int, print_json
 from .vibration_args import add_vibration_arguments, names, whirl_pairs
 
 
 def register(subparsers):
-    p = subparsers.add_parser(
-        "modes", help=SUMMARIES["modes"],
-        description="Linearise the model about its equilibrium (or its initial state) into "
-                    "M x'' + (D + G) x' + (K + N) x = 0 and list its modes and stability.")
-    add_model_arguments(p)
+    p = add_command(subparsers, "modes",
+                    "Linearise the model about its equilibrium (or its initial state) into "
+                    "M x'' + (D + G) x' + (K + N) x = 0 and list its modes and stability.", run)
     p.add_argument("--at", choices=("equilibrium", "initial"), default="equilibrium",
                    help="operating point (default: the equilibrium near the initial state)")
     p.add_argument("--route", choices=("numeric", "symbolic"), default="numeric",
@@ -33,7 +29,6 @@ def register(subparsers):
     p.add_argument("--amplitude", type=positive, default=0.1,
                    help="--animate's amplitude in the tangent coordinates (rad or m)")
     add_vibration_arguments(p)
-    p.set_defaults(func=run)
 
 
 def run(args):
@@ -62,14 +57,11 @@ def run(args):
         animate_mode(lin, md[args.mode - 1], args.animate, amplitude=args.amplitude)
         sys.stderr.write(f"mbdyn: wrote {args.animate}\n")
     if args.json:
-        sys.stdout.write(json.dumps({"model": scene.name, "case": scene.case, "at": args.at,
-                                     "equilibrium": eq.to_dict() if eq else None,
-                                     "linearization": lin.to_dict(),
-                                     **md.to_dict()}) + "\n")
+        print_json(scene, {"at": args.at, "equilibrium": eq.to_dict() if eq else None,
+                           "linearization": lin.to_dict(), **md.to_dict()})
         return 0
     w = sys.stdout.write
-    w(f"{scene.name} ({scene.path}{', case ' + scene.case if scene.case else ''}): "
-      f"linearised at the {args.at} state by the {args.route} route"
+    w(f"{heading(scene)}: linearised at the {args.at} state by the {args.route} route"
       + (f" (error estimate {lin.error:.1e})" if lin.route == "numeric" else "") + "\n")
     w(f"  coordinates: {', '.join(lin.names)}\n")
     if args.matrices:

@@ -5,27 +5,22 @@
 """
 from __future__ import annotations
 
-import os
 import sys
 
-from . import SUMMARIES
-from .common import Progress, add_model_arguments, load
+from .common import Progress, add_command, default_output, load, title
 
 
 def register(subparsers):
     from ..viz import SERIES_HELP
-    p = subparsers.add_parser(
-        "plot", help=SUMMARIES["plot"],
-        description="Simulate the model with its [simulation] settings and plot series "
-                    "against time (one axis per unit, events marked) or a phase portrait.")
-    add_model_arguments(p)
+    p = add_command(subparsers, "plot",
+                    "Simulate the model with its [simulation] settings and plot series "
+                    "against time (one axis per unit, events marked) or a phase portrait.", run)
     p.add_argument("--series", metavar="NAMES",
                    help="comma-separated: " + SERIES_HELP + " (default: the coordinates and "
                         "the energies when the file asks for them)")
     p.add_argument("--phase", metavar="X,Y", help="a phase portrait of two series")
     p.add_argument("--out", metavar="FILE", help="picture file: .png, .pdf or .svg (default "
                                                  "STEM.png in the current directory)")
-    p.set_defaults(func=run)
 
 
 def wanted_outputs(series):
@@ -45,10 +40,8 @@ def plot_run(scene, result, series=None, phase=None, out=None):
             if getattr(result, o if o == "energy" else "reactions") is None]
     if need:
         result.compute_outputs(tuple(need))
-    path = out or os.path.splitext(os.path.basename(scene.path))[0] + (
-        f"_{scene.case}" if scene.case else "") + ".png"
-    result.plot(series=series, phase=phase, out=path,
-                title=f"{scene.name}{' (case ' + scene.case + ')' if scene.case else ''}")
+    path = out or default_output(scene, ".png")
+    result.plot(series=series, phase=phase, out=path, title=title(scene))
     return path
 
 

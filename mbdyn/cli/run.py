@@ -5,13 +5,12 @@ import json
 import sys
 import warnings
 
-from . import SUMMARIES
 from .. import limits
 from ..errors import ModelWarning, SimulationError
 from ..io.loader import METHODS
 from ..io.results import summary, write_results
 from ..integrate.settings import FIXED_STEP, INTEGRATORS
-from .common import Progress, add_model_arguments, fmt, load
+from .common import Progress, add_command, fmt, heading, load
 
 #: options that are shorthands of --set simulation.KEY=VALUE
 FLAGS = (("simulation.t_end", "--t-end"), ("simulation.method", "--method"),
@@ -22,11 +21,8 @@ FLAGS = (("simulation.t_end", "--t-end"), ("simulation.method", "--method"),
 
 
 def register(subparsers):
-    p = subparsers.add_parser(
-        "run", help=SUMMARIES["run"],
-        description="Simulate a model file with its [simulation] settings; options "
-                    "override them (after --case and --set).")
-    add_model_arguments(p)
+    p = add_command(subparsers, "run", "Simulate a model file with its [simulation] "
+                    "settings; options override them (after --case and --set).", run)
     p.add_argument("--t-end", metavar="T", help="end time (s)")
     p.add_argument("--method", choices=METHODS, help="formulation: " + ", ".join(METHODS))
     p.add_argument("--integrator", choices=INTEGRATORS, metavar="NAME",
@@ -47,7 +43,6 @@ def register(subparsers):
                    help="print one JSON object (the summary) and nothing else on stdout")
     p.add_argument("--plot", metavar="FILE",
                    help="also plot the coordinates (and energies) into FILE (.png, .pdf, .svg)")
-    p.set_defaults(func=run)
 
 
 def run(args):
@@ -88,8 +83,7 @@ def report(scene, result, paths):
     s = summary(scene, result)
     st = result.stats
     out = sys.stdout
-    case = f", case {scene.case}" if scene.case else ""
-    out.write(f"{scene.name} ({scene.path}{case})\n")
+    out.write(heading(scene) + "\n")
     step = f", dt = {fmt(st.get('dt'))}" if st.get("dt") and st.get("integrator") in (
         "euler", "semi-implicit-euler", "rk4") else \
         f", rtol = {fmt(st.get('rtol'))}, atol = {fmt(st.get('atol'))}"

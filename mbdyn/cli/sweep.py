@@ -10,7 +10,6 @@ import math
 import os
 import sys
 
-from . import SUMMARIES
 from .. import limits
 from ..analysis.schedulers import check_spec
 from ..analysis.sweep import DEFAULT_QUANTITIES, parse_grid, sweep
@@ -19,15 +18,15 @@ from ..escape import spreadsheet_cell
 from ..files import check_target
 from ..io.schema import parse_set_value
 from ..viz.sweep_plots import FORMATS as PICTURES
-from .common import fmt, positive, positive_int
+from .common import add_command, fmt, positive, positive_int
 
 
 def register(subparsers):
-    p = subparsers.add_parser(
-        "sweep", help=SUMMARIES["sweep"],
-        description="Run MODEL once per member of a grid of overrides by dotted path and "
+    p = add_command(subparsers, "sweep",
+                    "Run MODEL once per member of a grid of overrides by dotted path and "
                     "keep quantities of each run in a table (CSV).  Ranges: START:STOP:N "
-                    "(N points, ends included), START:STOP:N:log, or a list [a, b, \"pi/4\"].")
+                    "(N points, ends included), START:STOP:N:log, or a list [a, b, \"pi/4\"].",
+                    run, model_arguments=False)
     p.add_argument("model", metavar="MODEL", help="model file (.toml)")
     p.add_argument("--grid", metavar="PATH=VALUES", action="append", default=[],
                    help="one axis of the grid, e.g. parameters.Mz=-0.03:-0.001:8 or "
@@ -61,7 +60,6 @@ def register(subparsers):
                    help="print the table as one JSON object {column: [values]} and nothing "
                         "else on stdout (the progress counter and a long sweep's estimate go "
                         "to stderr)")
-    p.set_defaults(func=run)
 
 
 def _fixed(items):
