@@ -13,8 +13,11 @@ max_steps=..., max_wall_time=...)``, the same keys in ``[simulation]``, or
 from __future__ import annotations
 
 # -- inputs
-#: bytes of one model file (the largest model in models/ is ~4 kB)
+#: bytes of one model file (the largest model in models/ is ~4 kB; a generated 5,000-body
+#: chain is ~0.7 MB); raised for a run by the environment variable MBDYN_MAX_FILE_BYTES
 MAX_FILE_BYTES = 1_000_000
+#: the most MBDYN_MAX_FILE_BYTES may ask for
+MAX_FILE_BYTES_SETTABLE = 1_000_000_000
 #: nesting of arrays and tables in a model file (the deepest legitimate use is 3)
 MAX_NESTING = 16
 #: magnitude of any number written in a model file or given as a value (beyond it,
@@ -50,6 +53,25 @@ MAX_SWEEP_MEMBERS = 1_000_000
 #: table is ~250 kB; a longer line is not a table mbdyn wrote)
 MAX_TABLE_LINE = 1_000_000
 
+
+
+def max_file_bytes():
+    """Bytes a model file may have: ``MAX_FILE_BYTES``, or the environment variable
+    ``MBDYN_MAX_FILE_BYTES`` (a whole number up to ``MAX_FILE_BYTES_SETTABLE``), read at
+    each use so that sweep workers and subprocesses inherit it."""
+    import os
+    from .errors import ModelError
+    text = os.environ.get("MBDYN_MAX_FILE_BYTES")
+    if text is None or not text.strip():
+        return MAX_FILE_BYTES
+    try:
+        value = int(text.strip())
+    except ValueError:
+        value = 0
+    if not 1 <= value <= MAX_FILE_BYTES_SETTABLE:
+        raise ModelError(f"MBDYN_MAX_FILE_BYTES={text!r}: give a whole number of bytes from 1 "
+                         f"to {MAX_FILE_BYTES_SETTABLE}")
+    return value
 
 
 def magnitude_problem(value):

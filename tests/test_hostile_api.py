@@ -840,3 +840,28 @@ print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, time.perf_count
     assert out.returncode == 0, out.stderr
     peak_mb, step_s = map(float, out.stdout.split())
     assert peak_mb < 1000 and step_s < 5, (peak_mb, step_s)
+
+
+def test_the_model_file_size_limit_is_named_and_settable(tmp_path, monkeypatch):
+    """A generated 7,000-body chain is over the default 1 MB: refused with the limit and
+    how to raise it; MBDYN_MAX_FILE_BYTES raises it (and a bad value is named)."""
+    rows = ['[model]\nname = "chain"\n']
+    for i in range(7000):
+        parent = "ground" if i == 0 else f"b{i - 1}"
+        rows.append(f'[[bodies]]\nname = "b{i}"\nmass = 1.0\ncom = [0.1, 0, 0]\n'
+                    f'inertia = [0.001, 0.001, 0.001]\n\n[[joints]]\nname = "j{i}"\n'
+                    f'type = "revolute"\nparent = "{parent}"\nchild = "b{i}"\naxis = "z"\n'
+                    f'position = [{0.1 if i else 0}, 0, 0]\n')
+    path = tmp_path / "chain.toml"
+    path.write_text("\n".join(rows))
+    assert path.stat().st_size > 1_000_000
+    monkeypatch.delenv("MBDYN_MAX_FILE_BYTES", raising=False)
+    with pytest.raises(mb.ModelFileError, match=r"more than a model file may be "
+                                                r"\(1000000\).*MBDYN_MAX_FILE_BYTES"):
+        mb.load_model(path)
+    monkeypatch.setenv("MBDYN_MAX_FILE_BYTES", "lots")
+    with pytest.raises(mb.ModelError, match=r"MBDYN_MAX_FILE_BYTES='lots'"):
+        mb.load_model(path)
+    monkeypatch.setenv("MBDYN_MAX_FILE_BYTES", "5000000")
+    from mbdyn.io.document import read_bytes
+    assert len(read_bytes(path)) == path.stat().st_size

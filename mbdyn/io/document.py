@@ -21,7 +21,7 @@ from .wording import format_path
 def read_document(path):
     """The parsed TOML of ``path``; errors name the file (and the line of a syntax error).
 
-    Only regular files of at most ``limits.MAX_FILE_BYTES`` are read (a FIFO or a device
+    Only regular files of at most ``limits.max_file_bytes()`` are read (a FIFO or a device
     such as ``/dev/zero`` would block or never end); the parsed document is then checked
     against the nesting and number limits (``scan_document``).
     """
@@ -30,8 +30,9 @@ def read_document(path):
 
 def read_bytes(path):
     """The bytes of the model file ``path``: a regular file of at most
-    ``limits.MAX_FILE_BYTES`` (errors name the file)."""
+    ``limits.max_file_bytes()`` (errors name the file)."""
     file = str(path)
+    limit = limits.max_file_bytes()
     try:
         # non-blocking open: a FIFO without a writer must not hang the reader
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
@@ -40,13 +41,14 @@ def read_bytes(path):
             if not stat.S_ISREG(info.st_mode):
                 raise ModelFileError(file, "", "is not a regular file (a FIFO, device or "
                                      "socket); give a .toml model file")
-            if info.st_size > limits.MAX_FILE_BYTES:
+            if info.st_size > limit:
                 raise ModelFileError(file, "", f"is {info.st_size} bytes, more than a model "
-                                     f"file may be ({limits.MAX_FILE_BYTES}); is it really a "
-                                     "model file?")
+                                     f"file may be ({limit}); is it really a model file? A "
+                                     "large generated model may raise the limit: "
+                                     "MBDYN_MAX_FILE_BYTES=BYTES")
             if hasattr(os, "set_blocking"):
                 os.set_blocking(fd, True)
-            data = fh.read(limits.MAX_FILE_BYTES + 1)
+            data = fh.read(limit + 1)
     except FileNotFoundError:
         raise ModelFileError(file, "", "no such file; check the path") from None
     except IsADirectoryError:
@@ -55,8 +57,8 @@ def read_bytes(path):
         raise ModelFileError(file, "", "cannot be read (permission denied)") from None
     except OSError as exc:
         raise ModelFileError(file, "", f"cannot be read ({exc.strerror or exc})") from None
-    if len(data) > limits.MAX_FILE_BYTES:
-        raise ModelFileError(file, "", f"grew beyond {limits.MAX_FILE_BYTES} bytes while "
+    if len(data) > limit:
+        raise ModelFileError(file, "", f"grew beyond {limit} bytes while "
                              "being read; give a finished model file")
     return data
 

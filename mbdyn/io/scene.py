@@ -71,9 +71,10 @@ def load_model(path, case=None, overrides=None, effects=None, *, text=None):
     if isinstance(overrides, str):
         raise ModelError("load_model: overrides must be a mapping {\"parameters.k\": 1.0} or "
                          "a list of \"PATH=VALUE\" texts, not one string")
-    if text is not None and len(text) > limits.MAX_FILE_BYTES:
+    if text is not None and len(text) > limits.max_file_bytes():
         raise ModelFileError(path, "", f"is more than a model file may be "
-                             f"({limits.MAX_FILE_BYTES} characters)")
+                             f"({limits.max_file_bytes()} characters; MBDYN_MAX_FILE_BYTES "
+                             "raises it)")
     doc = read_document(path) if text is None else parse_document(text, str(path))
     checker = Checker(path)
     checker.check_document(doc)
