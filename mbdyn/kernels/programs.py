@@ -22,9 +22,6 @@ STACK = 64
 def evaluate(ops, consts, first, last, t, y, stack):
     """The value at ``(t, y)`` of the program ``ops[first:last]`` (``stack``: scratch space
     of ``STACK`` values)."""
-    # long: the interpreter is one loop with a branch per opcode (the unary functions look
-    # alike but each calls its own); a table of functions would cost an indirect call per
-    # operation, which numba cannot inline.
     top = 0
     for k in range(first, last):
         op = ops[k, 0]
