@@ -24,19 +24,42 @@ a child's wrench back to the parent.  The velocity-product and drive parts of th
 accelerations enter through the kinematics' bias accelerations (computed with free
 ``u' = 0``): ``A_i = X A_p + S_i u'_i + c_i`` with ``c_i = A_bias_i - X A_bias_p``.
 """
-# long: the articulated-body kernel, the formulas only it inlines and the two kernels that
-# read its workspace after it: numba's cache is invalidated per source file, so they stay.
 import math
 
 from numba import njit
 
 from .joints import EULER, NU, REVOLUTE, SPHERICAL
-from .linalg3 import spatial_inertia
 from .views import UNCOUNTED, c_view
 
 #: floats of scratch ``articulated_body`` needs: ``ARTICULATED_WORK + 6 n`` for n frames
 #: (``joint_wrenches_tree`` needs 6)
 ARTICULATED_WORK = 87
+
+
+@njit(cache=True, inline="always")
+def _spatial_inertia(m, c, Iw, IA, i):
+    """Spatial inertia at the frame origin (world axes) of a body of mass ``m``, centre of
+    mass at ``c`` from the origin and inertia ``Iw`` about the centre of mass, into
+    ``IA[i]``: ``[[Iw - m [c]x [c]x, m [c]x], [-m [c]x, m E]]``.  (Arrays are indexed
+    with the frame number rather than passed as ``IA[i]`` views: a view costs two
+    reference-count calls, which dominated the cost of a small model.)"""
+    cx, cy, cz = c[0], c[1], c[2]
+    cc = cx * cx + cy * cy + cz * cz
+    IA[i, 0, 0] = Iw[0, 0] + m * (cc - cx * cx)
+    IA[i, 1, 1] = Iw[1, 1] + m * (cc - cy * cy)
+    IA[i, 2, 2] = Iw[2, 2] + m * (cc - cz * cz)
+    IA[i, 0, 1] = IA[i, 1, 0] = Iw[0, 1] - m * cx * cy
+    IA[i, 0, 2] = IA[i, 2, 0] = Iw[0, 2] - m * cx * cz
+    IA[i, 1, 2] = IA[i, 2, 1] = Iw[1, 2] - m * cy * cz
+    for a_ in range(3):
+        for b_ in range(3):
+            IA[i, 3 + a_, 3 + b_] = m if a_ == b_ else 0.0
+    IA[i, 0, 3], IA[i, 0, 4], IA[i, 0, 5] = 0.0, -m * cz, m * cy
+    IA[i, 1, 3], IA[i, 1, 4], IA[i, 1, 5] = m * cz, 0.0, -m * cx
+    IA[i, 2, 3], IA[i, 2, 4], IA[i, 2, 5] = -m * cy, m * cx, 0.0
+    for a_ in range(3):
+        for b_ in range(3):
+            IA[i, 3 + b_, a_] = IA[i, a_, 3 + b_]
 
 
 @njit(cache=True, inline="always")
@@ -142,8 +165,6 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
     of freedom without inertia).  ``work``: ``ARTICULATED_WORK + 6 n`` floats of scratch
     (the last ``6 n``: each joint's ``1 / L_jj``, so that its solves multiply).
     """
-    # long: three passes (bodies, leaves to root, root to leaves) updating the per-frame
-    # rows of IA, pA, cb, U, Dl in place; blocks with a formula of their own are helpers.
     n = mass.shape[0]
     Iw, Y, Vbig = c_view(work, 0, (3, 3)), c_view(work, 9, (6, 3)), c_view(work, 51, (6, 6))
     inv = c_view(work, ARTICULATED_WORK, (n, 6))
@@ -163,7 +184,7 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
                 Iw[a_, b_] = Iw[b_, a_] = (Y[a_, 0] * R[i, b_, 0] + Y[a_, 1] * R[i, b_, 1]
                                            + Y[a_, 2] * R[i, b_, 2])
         m_i = mass[i]
-        spatial_inertia(m_i, c, Iw, IA, i)
+        _spatial_inertia(m_i, c, Iw, IA, i)
         wi = wv
         for a_ in range(3):
             wi[a_] = w[i, a_]

@@ -10,7 +10,7 @@ from numba import njit
 from numba.extending import register_jitable
 
 from .kinematics import cross
-from .linalg3 import cross_to, mat_vec, rotate_tensor, spatial_inertia
+from .linalg3 import cross_to, mat_vec, rotate_tensor
 from .views import UNCOUNTED, c_view
 
 
@@ -136,28 +136,6 @@ def jourdain_terms(mass, com, inertia, has_inertia, R, r, w, alpha_b, a_b, JR, J
 
 
 @njit(cache=True, inline="always")
-def _first_own(i, parent, anc_ptr):
-    """Where frame ``i``'s own columns start in its column list ``anc_idx[anc_ptr[i]:]``:
-    they come last, columns being numbered in topological order, after every ancestor's."""
-    p = parent[i]
-    return anc_ptr[i] + (anc_ptr[p + 1] - anc_ptr[p] if p >= 0 else 0)
-
-
-@njit(cache=True, inline="always")
-def _own_twists(i, first, last, anc_idx, r, o, JR, JT, S):
-    """The twists ``S[col] = (w, v0)`` of frame ``i``'s own columns ``anc_idx[first:last]``,
-    ``v0 = v_origin_i - w x (r_i - o)``."""
-    for m in range(first, last):
-        col = anc_idx[m]
-        wx, wy, wz = JR[i, 0, col], JR[i, 1, col], JR[i, 2, col]
-        S[col, 0], S[col, 1], S[col, 2] = wx, wy, wz
-        dx, dy, dz = r[i, 0] - o[0], r[i, 1] - o[1], r[i, 2] - o[2]
-        S[col, 3] = JT[i, 0, col] - (wy * dz - wz * dy)
-        S[col, 4] = JT[i, 1, col] - (wz * dx - wx * dz)
-        S[col, 5] = JT[i, 2, col] - (wx * dy - wy * dx)
-
-
-@njit(cache=True, inline="always")
 def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc_idx, M, S, IC,
                           scratch):
     """``M`` by the composite-rigid-body algorithm, in world Pluecker coordinates.
@@ -174,6 +152,10 @@ def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc
     """
     n = mass.shape[0]
     nu = M.shape[0]
+    for i in range(n):
+        for a_ in range(6):
+            for b_ in range(6):
+                IC[i, a_, b_] = 0.0
     Iw, S3 = c_view(scratch, 0, (3, 3)), c_view(scratch, 9, (3, 3))
     c, Fc, o = c_view(scratch, 18, (3,)), c_view(scratch, 21, (6,)), c_view(scratch, 27, (3,))
     for a_ in range(nu):
@@ -182,14 +164,41 @@ def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc
     for k in range(3):
         o[k] = r[0, k] if n else 0.0
     for i in range(n):
-        _own_twists(i, _first_own(i, parent, anc_ptr), anc_ptr[i + 1], anc_idx, r, o, JR, JT,
-                    S)
-        # this body's spatial inertia about o
+        # this frame's own columns come last in its (sorted) column list: columns are
+        # numbered in topological order, after every ancestor's
+        p = parent[i]
+        inherited = anc_ptr[p + 1] - anc_ptr[p] if p >= 0 else 0
+        # twists of this frame's own columns
+        for m in range(anc_ptr[i] + inherited, anc_ptr[i + 1]):
+            col = anc_idx[m]
+            wx, wy, wz = JR[i, 0, col], JR[i, 1, col], JR[i, 2, col]
+            S[col, 0], S[col, 1], S[col, 2] = wx, wy, wz
+            # v0 = v_origin_i - w x (r_i - o)
+            dx, dy, dz = r[i, 0] - o[0], r[i, 1] - o[1], r[i, 2] - o[2]
+            S[col, 3] = JT[i, 0, col] - (wy * dz - wz * dy)
+            S[col, 4] = JT[i, 1, col] - (wz * dx - wx * dz)
+            S[col, 5] = JT[i, 2, col] - (wx * dy - wy * dx)
+        # this body's spatial inertia about the world origin
+        m_i = mass[i]
         rotate_tensor(R[i], inertia[i], S3, Iw)
         mat_vec(R[i], com[i], c)
-        for k in range(3):
-            c[k] = c[k] + r[i, k] - o[k]
-        spatial_inertia(mass[i], c, Iw, IC, i)
+        cx, cy, cz = c[0] + r[i, 0] - o[0], c[1] + r[i, 1] - o[1], c[2] + r[i, 2] - o[2]
+        cc = cx * cx + cy * cy + cz * cz
+        G = IC[i]
+        G[0, 0] = Iw[0, 0] + m_i * (cc - cx * cx)
+        G[1, 1] = Iw[1, 1] + m_i * (cc - cy * cy)
+        G[2, 2] = Iw[2, 2] + m_i * (cc - cz * cz)
+        G[0, 1] = G[1, 0] = Iw[0, 1] - m_i * cx * cy
+        G[0, 2] = G[2, 0] = Iw[0, 2] - m_i * cx * cz
+        G[1, 2] = G[2, 1] = Iw[1, 2] - m_i * cy * cz
+        # m [c]x (upper right) and its transpose (lower left)
+        G[0, 4], G[0, 5] = -m_i * cz, m_i * cy
+        G[1, 3], G[1, 5] = m_i * cz, -m_i * cx
+        G[2, 3], G[2, 4] = -m_i * cy, m_i * cx
+        for a_ in range(3):
+            for b_ in range(3):
+                G[3 + b_, a_] = G[a_, 3 + b_]
+        G[3, 3] = G[4, 4] = G[5, 5] = m_i
     # composite inertias, leaves to root
     for i in range(n - 1, -1, -1):
         p = parent[i]
@@ -198,7 +207,9 @@ def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc
                 for b_ in range(6):
                     IC[p, a_, b_] += IC[i, a_, b_]
     for i in range(n):
-        first_own = _first_own(i, parent, anc_ptr)
+        p = parent[i]
+        inherited = anc_ptr[p + 1] - anc_ptr[p] if p >= 0 else 0
+        first_own = anc_ptr[i] + inherited
         for m in range(first_own, anc_ptr[i + 1]):
             b_ = anc_idx[m]
             for a_ in range(6):

@@ -62,41 +62,6 @@ def drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, an
         ufull[k] = saved[k]
 
 
-@njit(inline="always", **UNCOUNTED)
-def motion_and_loads(tree, body, state, loads, motion, scratch):
-    """``kinematics_and_loads``, then, with the ``gyroscopic`` effect off (``switches[0]``
-    0), ``drop_velocity_products``: what every formulation starts from.  The groups as
-    ``jourdain_accelerations``'s, except ``body`` (``mass, com, gravity``); ``tree`` may end
-    with ``own_ptr``/``own_idx`` in place of the ancestor lists."""
-    parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx = tree
-    mass, com, gravity = body
-    qfull, ufull, udfull = state
-    (load_body, load_point, load_force, load_moment, load_in_body, force_int, force_data,
-     switches) = loads
-    R, r, w, v, alpha, a, JR, JT, F, N = motion
-    kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
-                         mass, com, gravity, qfull, ufull, udfull,
-                         load_body, load_point, load_force, load_moment, load_in_body,
-                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, F, N,
-                         scratch)
-    if switches[0] == 0:
-        drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr,
-                               anc_idx, qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT,
-                               scratch)
-
-
-@njit(inline="always", **UNCOUNTED)
-def _status(pivot, x):
-    """A solve's status: ``pivot`` where it broke down (>= 0), -2 when ``x`` holds NaN or
-    Inf, else -1."""
-    if pivot >= 0:
-        return pivot
-    for k in range(x.shape[0]):
-        if not np.isfinite(x[k]):
-            return -2
-    return -1
-
-
 # The two accelerations below take their arrays in groups (tuples, as ``packed._views``
 # returns them) and are inlined into their callers: a call of some forty arrays costs a
 # tenth of a small model's evaluation, and Python compiles a call of more than 30
@@ -115,12 +80,29 @@ def jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch):
     """
     parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx = tree
     mass, com, inertia, has_inertia, gravity = body
+    qfull, ufull, udfull = state
+    (load_body, load_point, load_force, load_moment, load_in_body, force_int, force_data,
+     switches) = loads
     R, r, w, v, alpha, a, JR, JT, F, N = motion
     M, f, L, ud = jourdain
-    motion_and_loads(tree, (mass, com, gravity), state, loads, motion, scratch)
+    kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
+                         mass, com, gravity, qfull, ufull, udfull,
+                         load_body, load_point, load_force, load_moment, load_in_body,
+                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, F, N,
+                         scratch)
+    if switches[0] == 0:
+        drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr,
+                               anc_idx, qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT,
+                               scratch)
     jourdain_terms(mass, com, inertia, has_inertia, R, r, w, alpha, a, JR, JT, anc_ptr,
                    anc_idx, parent, F, N, M, f, scratch)
-    return _status(cholesky_solve(M, f, L, ud), ud)
+    pivot = cholesky_solve(M, f, L, ud)
+    if pivot >= 0:
+        return pivot
+    for k in range(ud.shape[0]):
+        if not np.isfinite(ud[k]):
+            return -2
+    return -1
 
 
 @njit(cache=True)
@@ -134,10 +116,15 @@ def newton_euler_solution(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc
 
     Returns the unknowns ``x = [ud, lambda]`` (a new array).
     """
-    motion_and_loads((parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx),
-                     (mass, com, gravity), (qfull, ufull, udfull),
-                     (load_body, load_point, load_force, load_moment, load_in_body, force_int,
-                      force_data, switches), (R, r, w, v, alpha, a, JR, JT, F, N), scratch)
+    kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
+                         mass, com, gravity, qfull, ufull, udfull,
+                         load_body, load_point, load_force, load_moment, load_in_body,
+                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, F, N,
+                         scratch)
+    if switches[0] == 0:
+        drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr,
+                               anc_idx, qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT,
+                               scratch)
     newton_euler_system(mass, com, inertia, parent, R, r, w, alpha, a, JR, JT, anc_ptr, anc_idx,
                         F, N, react_joint, react_force, react_moment, A, b)
     return np.linalg.solve(A, b)
@@ -156,11 +143,28 @@ def articulated_accelerations(tree, body, state, loads, motion, work, ud, scratc
     """
     parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr, own_idx = tree
     mass, com, inertia, gravity = body
+    qfull, ufull, udfull = state
+    (load_body, load_point, load_force, load_moment, load_in_body, force_int, force_data,
+     switches) = loads
     R, r, w, v, alpha, a, JR, JT, F, N = motion
     IA, pA, cb, U, Dl, acc = work
-    motion_and_loads(tree, (mass, com, gravity), state, loads, motion, scratch)
-    return _status(articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha, a,
-                                    JR, JT, F, N, IA, pA, cb, U, Dl, acc, ud, scratch), ud)
+    kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr, own_idx,
+                         mass, com, gravity, qfull, ufull, udfull,
+                         load_body, load_point, load_force, load_moment, load_in_body,
+                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, F, N,
+                         scratch)
+    if switches[0] == 0:
+        drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr,
+                               own_idx, qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT,
+                               scratch)
+    pivot = articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha, a, JR, JT,
+                             F, N, IA, pA, cb, U, Dl, acc, ud, scratch)
+    if pivot >= 0:
+        return pivot
+    for k in range(ud.shape[0]):
+        if not np.isfinite(ud[k]):
+            return -2
+    return -1
 
 
 @njit(**UNCOUNTED)
@@ -182,4 +186,7 @@ def newton_euler_tree(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr
         return pivot
     joint_wrenches_tree(parent, r, IA, pA, acc, wrench, scratch)
     reaction_components(R, react_joint, react_force, react_moment, wrench, lam)
-    return _status(-1, lam)
+    for k in range(lam.shape[0]):
+        if not np.isfinite(lam[k]):
+            return -2
+    return -1

@@ -15,7 +15,7 @@ Status codes returned: 0 done, 1 non-finite state or acceleration, 2 mass matrix
 positive definite, 3 implicit midpoint's Newton iteration did not converge.
 """
 import numpy as np
-from numba import njit, types
+from numba import njit
 from numba.extending import overload
 
 from .evaluate import articulated_accelerations, jourdain_accelerations
@@ -192,63 +192,24 @@ def _scratch(ny):
             np.empty((ny, ny)))
 
 
-def step(scheme, h, y, yn, drives, nq, slots, free_q, free_u, drive_q, drive_u, tree, body,
-         loads, ws, k1, k2, k3, k4, tmp, J, nfev):
-    """One step of the scheme ``scheme`` (a code of ``SCHEMES``) with the steps' common
-    arguments; returns its status (see ``_step_of_scheme``)."""
-    raise NotImplementedError("compiled code only")
+# One compiled loop per scheme, so that a run compiles only its own scheme's step (a loop
+# over all four would compile all of them: about 9 s of a first run).  The loops differ
+# only in the step they call.  After each step they check the run's event conditions
+# (``kernels.events``; ``times[n]``: the time after step ``n``) and return early, status 0,
+# after a step where a terminal one crossed zero or one is not finite.
 
-
-_STEPS = {EULER: euler_step, SEMI_IMPLICIT_EULER: semi_implicit_euler_step, RK4: rk4_step,
-          IMPLICIT_MIDPOINT: midpoint_step}
-
-
-@overload(step, inline="always", prefer_literal=True)
-def _step_of_scheme(scheme, h, y, yn, drives, nq, slots, free_q, free_u, drive_q, drive_u,
-                    tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev):
-    """A scheme given as a constant (a loop of one scheme) compiles only that scheme's
-    step; one known at run time only (the batched ensembles) compiles all four."""
-    if isinstance(scheme, types.IntegerLiteral):
-        one = _STEPS[scheme.literal_value]
-
-        def one_scheme(scheme, h, y, yn, drives, nq, slots, free_q, free_u, drive_q, drive_u,
-                       tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev):
-            return one(h, y, yn, drives, nq, slots, free_q, free_u, drive_q, drive_u, tree,
-                       body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
-        return one_scheme
-
-    def any_scheme(scheme, h, y, yn, drives, nq, slots, free_q, free_u, drive_q, drive_u,
-                   tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev):
-        if scheme == EULER:
-            return euler_step(h, y, yn, drives, nq, slots, free_q, free_u, drive_q, drive_u,
-                              tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
-        if scheme == SEMI_IMPLICIT_EULER:
-            return semi_implicit_euler_step(h, y, yn, drives, nq, slots, free_q, free_u,
-                                            drive_q, drive_u, tree, body, loads, ws, k1, k2,
-                                            k3, k4, tmp, J, nfev)
-        if scheme == RK4:
-            return rk4_step(h, y, yn, drives, nq, slots, free_q, free_u, drive_q, drive_u,
-                            tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
-        return midpoint_step(h, y, yn, drives, nq, slots, free_q, free_u, drive_q, drive_u,
-                             tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
-    return any_scheme
-
-
-@njit(cache=True, inline="always")
-def _loop(scheme, h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, drive_u,
-          tree, body, loads, ws, out, nfev, times, events):
-    """``out.shape[0] - 1`` steps of ``scheme`` (see ``fixed_step_loop``), stopping early,
-    status 0, after a step where a terminal event condition crossed zero or one is not
-    finite (``kernels.events``; ``times[n]``: the time after step ``n``).  Returns
-    ``(steps done, status)``."""
+@njit(cache=True)
+def euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, drive_u,
+               tree, body, loads, ws, out, nfev, times, events):
+    """``fixed_step_loop`` with explicit Euler."""
     _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
     tree, body, loads, ws = untracked(tree), untracked(body), untracked(loads), untracked(ws)
     out, drive_table = untracked(out), untracked(drive_table)
-    check_events = events is not None and events[3].shape[0] > 0
+    check_events = events[3].shape[0] > 0
     for n in range(out.shape[0] - 1):
-        st = step(scheme, h, out[n], out[n + 1], drive_table[n], nq, slots, free_q, free_u,
-                  drive_q, drive_u, tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
+        st = euler_step(h, out[n], out[n + 1], drive_table[n], nq, slots, free_q, free_u,
+                        drive_q, drive_u, tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
         if st:
             return n, st
         _normalize(out[n + 1], quats)
@@ -257,41 +218,66 @@ def _loop(scheme, h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q,
     return out.shape[0] - 1, 0
 
 
-# One compiled loop per scheme, so that a run compiles only its own scheme's step (a loop
-# over all four would compile all of them: about 9 s of a first run): each is ``_loop``
-# with its scheme as a constant.
-
-@njit(cache=True)
-def euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, drive_u,
-               tree, body, loads, ws, out, nfev, times, events):
-    """``fixed_step_loop`` with explicit Euler, and the run's event conditions."""
-    return _loop(EULER, h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, drive_u,
-                 tree, body, loads, ws, out, nfev, times, events)
-
-
 @njit(cache=True)
 def semi_implicit_euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q,
                              drive_u, tree, body, loads, ws, out, nfev, times, events):
-    """``fixed_step_loop`` with semi-implicit Euler, and the run's event conditions."""
-    return _loop(SEMI_IMPLICIT_EULER, h, y0, drive_table, nq, slots, quats, free_q, free_u,
-                 drive_q, drive_u, tree, body, loads, ws, out, nfev, times, events)
+    """``fixed_step_loop`` with semi-implicit Euler."""
+    _copy(y0, out[0])
+    k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
+    tree, body, loads, ws = untracked(tree), untracked(body), untracked(loads), untracked(ws)
+    out, drive_table = untracked(out), untracked(drive_table)
+    check_events = events[3].shape[0] > 0
+    for n in range(out.shape[0] - 1):
+        st = semi_implicit_euler_step(h, out[n], out[n + 1], drive_table[n], nq, slots,
+                                      free_q, free_u, drive_q, drive_u, tree, body, loads, ws,
+                                      k1, k2, k3, k4, tmp, J, nfev)
+        if st:
+            return n, st
+        _normalize(out[n + 1], quats)
+        if check_events and step_ends_stretch(events, times[n], out[n + 1], n):
+            return n + 1, 0
+    return out.shape[0] - 1, 0
 
 
 @njit(cache=True)
 def rk4_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, drive_u, tree,
              body, loads, ws, out, nfev, times, events):
-    """``fixed_step_loop`` with RK4, and the run's event conditions."""
-    return _loop(RK4, h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, drive_u,
-                 tree, body, loads, ws, out, nfev, times, events)
+    """``fixed_step_loop`` with RK4."""
+    _copy(y0, out[0])
+    k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
+    tree, body, loads, ws = untracked(tree), untracked(body), untracked(loads), untracked(ws)
+    out, drive_table = untracked(out), untracked(drive_table)
+    check_events = events[3].shape[0] > 0
+    for n in range(out.shape[0] - 1):
+        st = rk4_step(h, out[n], out[n + 1], drive_table[n], nq, slots, free_q, free_u,
+                      drive_q, drive_u, tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
+        if st:
+            return n, st
+        _normalize(out[n + 1], quats)
+        if check_events and step_ends_stretch(events, times[n], out[n + 1], n):
+            return n + 1, 0
+    return out.shape[0] - 1, 0
 
 
 @njit(cache=True)
 def implicit_midpoint_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q,
                            drive_u, tree, body, loads, ws, out, nfev, times, events):
-    """``fixed_step_loop`` with the implicit midpoint rule, and the run's event
-    conditions."""
-    return _loop(IMPLICIT_MIDPOINT, h, y0, drive_table, nq, slots, quats, free_q, free_u,
-                 drive_q, drive_u, tree, body, loads, ws, out, nfev, times, events)
+    """``fixed_step_loop`` with the implicit midpoint rule."""
+    _copy(y0, out[0])
+    k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
+    tree, body, loads, ws = untracked(tree), untracked(body), untracked(loads), untracked(ws)
+    out, drive_table = untracked(out), untracked(drive_table)
+    check_events = events[3].shape[0] > 0
+    for n in range(out.shape[0] - 1):
+        st = midpoint_step(h, out[n], out[n + 1], drive_table[n], nq, slots, free_q, free_u,
+                           drive_q, drive_u, tree, body, loads, ws, k1, k2, k3, k4, tmp, J,
+                           nfev)
+        if st:
+            return n, st
+        _normalize(out[n + 1], quats)
+        if check_events and step_ends_stretch(events, times[n], out[n + 1], n):
+            return n + 1, 0
+    return out.shape[0] - 1, 0
 
 
 #: the compiled loop of each scheme code
@@ -309,8 +295,30 @@ def fixed_step_loop(scheme, h, y0, drive_table, nq, slots, quats, free_q, free_u
 
     The scheme is chosen at run time (for ``kernels.batched``), so this compiles all four
     steps; a single run calls its scheme's loop in ``LOOPS``, which does the same steps."""
-    return _loop(scheme, h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q,
-                 drive_u, tree, body, loads, ws, out, nfev, None, None)
+    _copy(y0, out[0])
+    k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
+    tree, body, loads, ws = untracked(tree), untracked(body), untracked(loads), untracked(ws)
+    out, drive_table = untracked(out), untracked(drive_table)
+    for n in range(out.shape[0] - 1):
+        y, yn, drives = out[n], out[n + 1], drive_table[n]
+        if scheme == EULER:
+            st = euler_step(h, y, yn, drives, nq, slots, free_q, free_u, drive_q, drive_u,
+                            tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
+        elif scheme == SEMI_IMPLICIT_EULER:
+            st = semi_implicit_euler_step(h, y, yn, drives, nq, slots, free_q, free_u,
+                                          drive_q, drive_u, tree, body, loads, ws, k1, k2, k3,
+                                          k4, tmp, J, nfev)
+        elif scheme == RK4:
+            st = rk4_step(h, y, yn, drives, nq, slots, free_q, free_u, drive_q, drive_u, tree,
+                          body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
+        else:
+            st = midpoint_step(h, y, yn, drives, nq, slots, free_q, free_u, drive_q,
+                                         drive_u, tree, body, loads, ws, k1, k2, k3, k4, tmp, J,
+                                         nfev)
+        if st:
+            return n, st
+        _normalize(yn, quats)
+    return out.shape[0] - 1, 0
 
 
 @njit(cache=True)

@@ -46,27 +46,11 @@ def forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_pt
          udfull, R, r, w, v, alpha, a, JR, JT, np.empty(KINEMATICS_WORK))
 
 
-@njit(cache=True, inline="always")
-def _relative_rates(H, h, uj, udj, nu, x, dx):
-    """A joint's relative velocity ``x = H u_j`` and acceleration ``dx = h + H u_j'`` (its
-    angular ``Hw``, ``hw`` or translational ``Hv``, ``hv`` part of ``joint_motion``)."""
-    for k in range(3):
-        x[k] = 0.0
-        dx[k] = h[k]
-    for c in range(nu):
-        for k in range(3):
-            x[k] += H[k, c] * uj[c]
-            dx[k] += H[k, c] * udj[c]
-
-
 @njit(**UNCOUNTED)
 def walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull, ufull,
          udfull, R, r, w, v, alpha, a, JR, JT, work):
     """``forward_kinematics`` in the scratch ``work`` (at least ``KINEMATICS_WORK``
     floats): it allocates nothing, so that it can run uncounted (``views.UNCOUNTED``)."""
-    # long: steps 1-6 of a frame in one loop body, parents first, over some 30 scratch
-    # views that every step shares: split into functions, each would take most of them
-    # as arguments (the pieces with a job of their own are inlined helpers).
     n = parent.shape[0]
     # Per-frame rows are copied into this scratch, element by element, rather than passed
     # on as views (R[p], w[p], ...): each view costs reference-count calls, which cost
@@ -130,7 +114,13 @@ def walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qf
         # relative velocities and accelerations of the joint (child / J0 components); a
         # joint that only turns about the child's origin has none of translation
         turns = kd == REVOLUTE or kd == EULER or kd == SPHERICAL
-        _relative_rates(Hw, hw, uj, udj, nu, wrel_b, dwrel_b)
+        for k in range(3):
+            wrel_b[k] = 0.0
+            dwrel_b[k] = hw[k]
+        for c in range(nu):
+            for k in range(3):
+                wrel_b[k] += Hw[k, c] * uj[c]
+                dwrel_b[k] += Hw[k, c] * udj[c]
         mat_vec(Ri, wrel_b, wrel)
         mat_vec(Ri, dwrel_b, t3)              # relative angular acceleration, world
         if turns:
@@ -138,7 +128,13 @@ def walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qf
                 vrel[k] = 0.0
                 t4[k] = 0.0
         else:
-            _relative_rates(Hv, hv, uj, udj, nu, vrel_j, dvrel_j)
+            for k in range(3):
+                vrel_j[k] = 0.0
+                dvrel_j[k] = hv[k]
+            for c in range(nu):
+                for k in range(3):
+                    vrel_j[k] += Hv[k, c] * uj[c]
+                    dvrel_j[k] += Hv[k, c] * udj[c]
             mat_vec(RJ0, vrel_j, vrel)
             mat_vec(RJ0, dvrel_j, t4)         # relative acceleration, world
         if p >= 0:

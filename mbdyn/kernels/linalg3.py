@@ -47,29 +47,3 @@ def cross_to(a, b, out):
     out[0] = a[1] * b[2] - a[2] * b[1]
     out[1] = a[2] * b[0] - a[0] * b[2]
     out[2] = a[0] * b[1] - a[1] * b[0]
-
-
-@njit(cache=True, inline="always")
-def spatial_inertia(m, c, Iw, IA, i):
-    """Spatial inertia about a reference point (world axes) of a body of mass ``m``,
-    centre of mass at ``c`` from that point and inertia ``Iw`` about the centre of mass,
-    into ``IA[i]``: ``[[Iw - m [c]x [c]x, m [c]x], [-m [c]x, m E]]``.  (Arrays are indexed
-    with the frame number rather than passed as ``IA[i]`` views: a view costs two
-    reference-count calls, which dominated the cost of a small model.)"""
-    cx, cy, cz = c[0], c[1], c[2]
-    cc = cx * cx + cy * cy + cz * cz
-    IA[i, 0, 0] = Iw[0, 0] + m * (cc - cx * cx)
-    IA[i, 1, 1] = Iw[1, 1] + m * (cc - cy * cy)
-    IA[i, 2, 2] = Iw[2, 2] + m * (cc - cz * cz)
-    IA[i, 0, 1] = IA[i, 1, 0] = Iw[0, 1] - m * cx * cy
-    IA[i, 0, 2] = IA[i, 2, 0] = Iw[0, 2] - m * cx * cz
-    IA[i, 1, 2] = IA[i, 2, 1] = Iw[1, 2] - m * cy * cz
-    for a_ in range(3):
-        for b_ in range(3):
-            IA[i, 3 + a_, 3 + b_] = m if a_ == b_ else 0.0
-    IA[i, 0, 3], IA[i, 0, 4], IA[i, 0, 5] = 0.0, -m * cz, m * cy
-    IA[i, 1, 3], IA[i, 1, 4], IA[i, 1, 5] = m * cz, 0.0, -m * cx
-    IA[i, 2, 3], IA[i, 2, 4], IA[i, 2, 5] = -m * cy, m * cx, 0.0
-    for a_ in range(3):
-        for b_ in range(3):
-            IA[i, 3 + b_, a_] = IA[i, a_, 3 + b_]
