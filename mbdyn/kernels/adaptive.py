@@ -22,6 +22,9 @@ Status codes: 0 done (stretch full or ``t_end`` reached), 1 non-finite derivativ
 matrix not positive definite (both at the stage time and state left in ``fail``), 4 step
 size below the roundoff of ``t``.
 """
+# long: the embedded Runge-Kutta pairs' tableaus (data) and the compiled stretch that uses
+# them stay in one file: numba's cache is invalidated per source file, and a kernel must
+# not outlive a change of the coefficients it was compiled with.
 import numpy as np
 from numba import njit
 
@@ -278,6 +281,10 @@ def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_s
     On failure ``fail`` holds the stage's time, then its state.  Returns
     ``(accepted, status, h_abs, i_eval)``; ``quats`` is unused (no projection: the drift is
     reported, as with scipy's solvers)."""
+    # long: one compiled loop over accepted steps (stages, error norm, step control, dense
+    # output, events): split into helpers numba must inline, it compiled 4 s longer cold on
+    # the 2-core machine for no speed (measured for issue 23), and not inlined it pays a call
+    # per stage.
     n = y.shape[0]
     stages = B.shape[0] + 1
     # untracked aliases of the model's arrays: views of them cost no reference counting

@@ -24,6 +24,9 @@ a child's wrench back to the parent.  The velocity-product and drive parts of th
 accelerations enter through the kinematics' bias accelerations (computed with free
 ``u' = 0``): ``A_i = X A_p + S_i u'_i + c_i`` with ``c_i = A_bias_i - X A_bias_p``.
 """
+# long: the articulated-body algorithm and the joint wrenches computed with it share their
+# inlined helpers, which must sit in the same file as the kernels (numba's on-disk cache is
+# invalidated per source file, docs/architecture.md).
 import math
 
 from numba import njit
@@ -165,6 +168,10 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
     of freedom without inertia).  ``work``: ``ARTICULATED_WORK + 6 n`` floats of scratch
     (the last ``6 n``: each joint's ``1 / L_jj``, so that its solves multiply).
     """
+    # long: the articulated-body algorithm's three sweeps over the tree (bias accelerations,
+    # leaves to root, root to leaves) fused so each frame's rows stay in the scratch; its
+    # helpers, inlined, made the first compile slower (issue 23) and not inlined cost a call
+    # per frame.
     n = mass.shape[0]
     Iw, Y, Vbig = c_view(work, 0, (3, 3)), c_view(work, 9, (6, 3)), c_view(work, 51, (6, 6))
     inv = c_view(work, ARTICULATED_WORK, (n, 6))

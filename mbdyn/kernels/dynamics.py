@@ -5,6 +5,9 @@ Everything in inertial (world) components.  Per body: mass ``m``, centre of mass
 of mass in body axes.  Applied loads are reduced to each body's centre of mass:
 force ``F[i]`` and moment ``N[i]``.
 """
+# long: Jourdain's M and f, the dense Newton-Euler system and the Cholesky solves share
+# inlined helpers, which must sit in the same file as the kernels that inline them (numba's
+# on-disk cache is invalidated per source file, docs/architecture.md).
 import numpy as np
 from numba import njit
 from numba.extending import register_jitable
@@ -150,6 +153,8 @@ def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc
 
     Scratch: ``S`` (nu x 6), ``IC`` (n x 6 x 6) and ``scratch`` (at least 33 floats).
     """
+    # long: the composite-rigid-body sweep and its projection on the joints' columns in one
+    # loop, so the spatial inertia of each subtree never leaves the scratch.
     n = mass.shape[0]
     nu = M.shape[0]
     for i in range(n):

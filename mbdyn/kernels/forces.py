@@ -156,6 +156,8 @@ def force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r,
     """Add every force element's wrenches to ``F``, ``N``; with ``acc.shape[0] >= 2`` also
     their potential energy (``acc[0]``) and non-conservative power (``acc[1]``).
     ``work``: at least ``FORCE_WORK`` floats of scratch."""
+    # long: one branch per force-element kind in one compiled loop: a kernel per kind would be
+    # one more compiled entry point per kind and a dispatch per element.
     want = acc.shape[0] >= 2
     tmp, six = work[0:48], work[48:FORCE_WORK]
     pa, pb, va, vb, d, f = tmp[0:3], tmp[3:6], tmp[6:9], tmp[9:12], tmp[12:15], tmp[15:18]

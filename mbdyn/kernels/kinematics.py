@@ -51,6 +51,9 @@ def walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qf
          udfull, R, r, w, v, alpha, a, JR, JT, work):
     """``forward_kinematics`` in the scratch ``work`` (at least ``KINEMATICS_WORK``
     floats): it allocates nothing, so that it can run uncounted (``views.UNCOUNTED``)."""
+    # long: steps 1-6 of the textbook for one frame after another in one loop (rotation,
+    # position, velocities, accelerations, Jacobian columns): numba passes rows of the
+    # parent's results through the scratch, not as arguments of helper calls.
     n = parent.shape[0]
     # Per-frame rows are copied into this scratch, element by element, rather than passed
     # on as views (R[p], w[p], ...): each view costs reference-count calls, which cost

@@ -22,6 +22,8 @@ STACK = 64
 def evaluate(ops, consts, first, last, t, y, stack):
     """The value at ``(t, y)`` of the program ``ops[first:last]`` (``stack``: scratch space
     of ``STACK`` values)."""
+    # long: the stack machine's interpreter: one branch per opcode in one loop (a table of
+    # functions would be an indirect call per operation in compiled code).
     top = 0
     for k in range(first, last):
         op = ops[k, 0]
