@@ -124,6 +124,17 @@ def test_the_allowed_upward_imports_still_exist():
         assert any(x == a and (y == b or y.startswith(b + ".")) for x, y in graph.edges), (a, b)
 
 
+#: places still over the size rule, each to be split (issue 23): listed by name so that the
+#: list can only shrink -- a place that is no longer long must be taken off it
+PENDING_SPLIT = {
+    "mbdyn/symbolic/walk.py",                      # 614 lines: the force elements' wrenches
+    "mbdyn/symbolic/walk.py:_walk_frame",          # and the joint formulas to move out
+    "mbdyn/symbolic/walk.py:_apply_forces",        # one function per force-element kind
+    "mbdyn/symbolic/steps.py:build_steps",         # one function per textbook step
+    "mbdyn/symbolic/codegen.py:generate_source",   # the generated module's parts
+}
+
+
 def test_modules_and_functions_stay_small():
     """No module over 400 lines and no function over 60 lines of code (its docstring not
     counted) without a reason written at its top (a comment line starting ``# long:``
@@ -132,8 +143,9 @@ def test_modules_and_functions_stay_small():
     for path in PACKAGE.rglob("*.py"):
         text = path.read_text()
         lines = text.splitlines()
+        where = str(path.relative_to(PACKAGE.parent))
         if len(lines) > 400 and not any(ln.startswith("# long:") for ln in lines[:40]):
-            long_modules.append(f"{path.relative_to(PACKAGE.parent)}: {len(lines)}")
+            long_modules.append(f"{where}: {len(lines)}")
         for node in ast.walk(ast.parse(text)):
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 first = node.body[0]
@@ -142,9 +154,11 @@ def test_modules_and_functions_stay_small():
                 size = node.end_lineno - start
                 head = lines[node.lineno:start + 3]
                 if size > 60 and not any(ln.strip().startswith("# long:") for ln in head):
-                    long_functions.append(f"{path.relative_to(PACKAGE.parent)}:"
-                                          f"{node.lineno} {node.name} ({size} lines)")
-    assert long_modules == [] and long_functions == []
+                    long_functions.append(f"{where}:{node.name} ({size} lines)")
+    found = {x.split(": ")[0] for x in long_modules} | {x.split(" (")[0]
+                                                        for x in long_functions}
+    assert sorted(found - PENDING_SPLIT) == []
+    assert sorted(PENDING_SPLIT - found) == [], "split: take it off PENDING_SPLIT"
 
 
 if __name__ == "__main__":      # print the graph's upward edges and the long places
