@@ -124,17 +124,6 @@ def test_the_allowed_upward_imports_still_exist():
         assert any(x == a and (y == b or y.startswith(b + ".")) for x, y in graph.edges), (a, b)
 
 
-#: places still over the size rule, each to be split (issue 23): listed by name so that the
-#: list can only shrink -- a place that is no longer long must be taken off it
-PENDING_SPLIT = {
-    "mbdyn/symbolic/walk.py",                      # 614 lines: the force elements' wrenches
-    "mbdyn/symbolic/walk.py:_walk_frame",          # and the joint formulas to move out
-    "mbdyn/symbolic/walk.py:_apply_forces",        # one function per force-element kind
-    "mbdyn/symbolic/steps.py:build_steps",         # one function per textbook step
-    "mbdyn/symbolic/codegen.py:generate_source",   # the generated module's parts
-}
-
-
 def test_modules_and_functions_stay_small():
     """No module over 400 lines and no function over 60 lines of code (its docstring not
     counted) without a reason written at its top (a comment line starting ``# long:``
@@ -155,10 +144,7 @@ def test_modules_and_functions_stay_small():
                 head = lines[node.lineno:start + 3]
                 if size > 60 and not any(ln.strip().startswith("# long:") for ln in head):
                     long_functions.append(f"{where}:{node.name} ({size} lines)")
-    found = {x.split(": ")[0] for x in long_modules} | {x.split(" (")[0]
-                                                        for x in long_functions}
-    assert sorted(found - PENDING_SPLIT) == []
-    assert sorted(PENDING_SPLIT - found) == [], "split: take it off PENDING_SPLIT"
+    assert long_modules == [] and long_functions == []
 
 
 if __name__ == "__main__":      # print the graph's upward edges and the long places

@@ -82,24 +82,21 @@ class Model:
     # ------------------------------------------------------------------ names and records
     def joint(self, name):
         """The joint record (kind, axis, parent, child, coordinates, drive...)."""
-        return _look_up(self._joint, name, "joint", self.joints)
+        return _look_up(self._joint, name, "joint", "joints", self.joints)
 
     def body(self, name):
         """The body record (mass, com, inertia about the centre of mass)."""
-        return _look_up(self._body, name, "body or frame", self.frames)
+        return _look_up(self._body, name, "body or frame", "bodies and frames", self.frames)
 
     def coordinate_index(self, name):
-        return _look_up(self._coordinate_index, name, "coordinate", self.coordinates)
+        return _look_up(self._coordinate_index, name, "coordinate", "coordinates",
+                        self.coordinates)
 
     def speed_index(self, name):
-        return _look_up(self._speed_index, name, "speed", self.speeds)
+        return _look_up(self._speed_index, name, "speed", "speeds", self.speeds)
 
     def frame_index(self, name):
-        try:
-            return self._frame_index[name]
-        except KeyError:
-            raise ModelError(f"unknown frame {name!r}; the model's frames are "
-                             f"{', '.join(self.frames)}") from None
+        return _look_up(self._frame_index, name, "frame", "frames", self.frames)
 
     @property
     def driven_joints(self):
@@ -233,10 +230,11 @@ class Model:
                 tree, body, self._loads_arrays, ws)
 
 
-def _look_up(table, name, what, known):
-    """``table[name]``, or a ``ModelError`` listing the names there are."""
+def _look_up(table, name, what, plural, known):
+    """``table[name]``, or a ``ModelError`` naming what is unknown and listing the names
+    there are."""
     try:
         return table[name]
     except (KeyError, TypeError):
-        raise ModelError(f"unknown {what} {name!r}; the model's are "
+        raise ModelError(f"unknown {what} {name!r}; the model's {plural} are "
                          f"{', '.join(map(str, known)) or '(none)'}") from None

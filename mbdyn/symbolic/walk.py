@@ -27,131 +27,23 @@ components; the textbook's transformation matrix is ``T = (C Rrel)^T`` (``B s = 
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 
 import numpy as np
 import sympy
 
 from ..errors import ModelError
+from .force_elements import apply_forces
+from .frames import (FrameMotion, _cross_columns, _joint_values, joint_motion,
+                     quaternion_rates)
 from .simplify import (compact, compact_matrix, diff, free_symbols, replace_shared,
                        tree_size)
 from .symbols import (Symbols, axis_vector, canonical, cross, exact, exact_matrix,
-                      exact_vector, orientation_matrix, quaternion_matrix,
-                      rotation_about_axis, rotation_about_coordinate_axis)
+                      exact_vector, orientation_matrix)
 
 FRAMES = ("own", "inertial")
 
 E3 = sympy.eye(3)
 Z3 = sympy.zeros(3, 1)
-
-
-@dataclass
-class FrameMotion:
-    """Everything the walk knows about one frame (vectors in ``basis`` components)."""
-    index: int
-    name: str
-    joint: object            # the Joint record
-    parent: str
-    basis: str               # "B<i>" label of the components used, or "I"
-    T: sympy.Matrix          # joint transformation matrix B s = T P s
-    Rrel: sympy.Matrix       # J0 <- B
-    C: sympy.Matrix          # P <- J0
-    rho_p: sympy.Matrix      # parent origin -> this origin, parent components
-    com: sympy.Matrix        # origin -> centre of mass, own components
-    mass: sympy.Expr
-    inertia: sympy.Matrix    # about the centre of mass, own axes
-    w_rel: sympy.Matrix      # relative angular velocity, own components
-    omega: sympy.Matrix
-    alpha: sympy.Matrix
-    r: sympy.Matrix          # position of the origin from the inertial origin
-    v: sympy.Matrix
-    a: sympy.Matrix
-    r_G: sympy.Matrix
-    v_G: sympy.Matrix
-    a_G: sympy.Matrix
-    JR: sympy.Matrix         # d omega / d u   (3 x nu)
-    JT: sympy.Matrix         # d v_G / d u     (3 x nu)
-    gravity: sympy.Matrix    # gravitational acceleration in basis components
-    X_child: sympy.Matrix    # basis <- own axes
-    w_rel_basis: sympy.Matrix = None   # relative angular velocity of the joint, basis comps
-    v_rel_basis: sympy.Matrix = None   # relative velocity of the joint, basis comps
-    force: sympy.Matrix = None     # applied force (gravity + loads), basis components
-    moment: sympy.Matrix = None    # applied moment about the centre of mass
-    loads: list = field(default_factory=list)   # (name, F, N, point) basis comps / own point
-    children: list = field(default_factory=list)
-
-    @property
-    def has_inertia(self):
-        return self.mass != 0 or any(e != 0 for e in self.inertia)
-
-    @property
-    def inertia_basis(self):
-        X = self.X_child
-        return self.inertia if X is E3 else X * self.inertia * X.T
-
-    @property
-    def com_basis(self):
-        return self.com if self.X_child is E3 else self.X_child * self.com
-
-
-def _joint_values(joint, sym, qi, ui):
-    """Coordinates, speeds and speed rates of a joint: symbols, or its drive's expressions."""
-    if joint.drive is not None:
-        expr = joint.symbolic.get("drive") if isinstance(joint.symbolic, dict) else None
-        if expr is None:
-            expr = joint.drive.expression
-        if expr is None:
-            raise ModelError(f"joint {joint.name!r}: its drive is given as Python functions; a "
-                             "symbolic derivation needs it as a sympy expression of mb.t "
-                             "(e.g. drive=Omega*mb.t)")
-        expr = canonical(sympy.sympify(expr), sym.table)
-        return [expr], [expr.diff(sym.t)], [expr.diff(sym.t, 2)], True
-    if not joint.nu:
-        return [], [], [], False
-    return (sym.q[qi:qi + joint.nq], sym.u[ui:ui + joint.nu], sym.ud[ui:ui + joint.nu], False)
-
-
-def joint_motion(joint, axis, qj, uj):
-    """Symbolic ``Rrel`` (J0 <- B), offset ``d`` (J0), relative angular velocity (B comps)
-    and relative velocity (J0 comps) of a joint; see ``mbdyn.kernels.joints``."""
-    kind = joint.kind
-    if kind == "fixed":
-        return E3, Z3, Z3, Z3
-    if kind == "revolute":
-        return rotation_about_axis(axis, qj[0]), Z3, axis * uj[0], Z3
-    if kind == "prismatic":
-        return E3, axis * qj[0], Z3, axis * uj[0]
-    if kind == "euler":
-        s0, s1, s2 = joint.sequence
-        R0 = rotation_about_coordinate_axis(s0, qj[0])
-        R1 = rotation_about_coordinate_axis(s1, qj[1])
-        R2 = rotation_about_coordinate_axis(s2, qj[2])
-        e = [E3[:, k] for k in range(3)]
-        w = R2.T * (R1.T * e[s0]) * uj[0] + R2.T * e[s1] * uj[1] + e[s2] * uj[2]
-        return R0 * R1 * R2, Z3, w, Z3
-    if kind == "spherical":
-        return quaternion_matrix(*qj), Z3, sympy.Matrix(uj), Z3
-    if kind == "free":
-        return (quaternion_matrix(*qj[3:7]), sympy.Matrix(qj[0:3]), sympy.Matrix(uj[3:6]),
-                sympy.Matrix(uj[0:3]))
-    raise ModelError(f"joint {joint.name!r}: unknown kind {kind!r}")
-
-
-def _cross_columns(r, A):
-    """``r x`` every column of ``A`` (3 x n)."""
-    out = sympy.zeros(3, A.cols)
-    for k in range(A.cols):
-        a = A[:, k]
-        if any(e != 0 for e in a):
-            out[:, k] = cross(r, a)
-    return out
-
-
-def quaternion_rates(qj, w):
-    """``q' = 1/2 q (x) (0, w)``, ``w`` in child components."""
-    a, b, c, d = qj
-    return [(-b * w[0] - c * w[1] - d * w[2]) / 2, (a * w[0] - d * w[1] + c * w[2]) / 2,
-            (d * w[0] + a * w[1] - b * w[2]) / 2, (-c * w[0] + b * w[1] + a * w[2]) / 2]
 
 
 def too_large(model, what, size, limit, remedy=""):
@@ -223,7 +115,7 @@ class Walk:
             if joint.parent in self.by_name:
                 self.by_name[joint.parent].children.append(m)
         self._apply_loads()
-        self._apply_forces()
+        apply_forces(self)
 
     # ------------------------------------------------------------------ helpers
     def s(self, expr):
@@ -344,8 +236,18 @@ class Walk:
         v_G = s(v + cross(omega, c))
         a_G = s(a + cross(alpha, c) + cross(omega, cross(omega, c)))
         g = s(X * gp)
-        # Jacobians recursively, as the numeric kernel does: inherit the parent's columns
-        # (rotated into this basis, the translation one moved along rho), add this joint's
+        JR, JO, JT = self._jacobians(parent, joint, uj, X, rho, w_rel_b, v_rel, c)
+        basis = f"B{i + 1}" if own else "I"
+        fm = FrameMotion(i, body.name, joint, joint.parent, basis, T, Rrel, C, rho_p, com,
+                         mass, inertia, w_rel, omega, alpha, r, v, a, r_G, v_G, a_G, JR, JT,
+                         g, Xc, w_rel_b, v_rel)
+        fm.JO = JO
+        return fm
+
+    def _jacobians(self, parent, joint, uj, X, rho, w_rel_b, v_rel, c):
+        """``(JR, JO, JT)`` of a frame recursively, as the numeric kernel does: the parent's
+        columns (rotated into this basis, the translation one moved along ``rho``) plus
+        this joint's; ``JO`` of the origin, ``JT`` of the centre of mass (at ``c``)."""
         JR_p = parent.JR if parent is not None else sympy.zeros(3, len(self.sym.u))
         JO_p = parent.JO if parent is not None else sympy.zeros(3, len(self.sym.u))
         JR = X * JR_p
@@ -356,13 +258,7 @@ class Walk:
             JO[:, col] += v_rel.diff(u)
         JR = self.s(JR)
         JO = self.s(JO)
-        JT = self.s(JO - _cross_columns(c, JR))
-        basis = f"B{i + 1}" if own else "I"
-        fm = FrameMotion(i, body.name, joint, joint.parent, basis, T, Rrel, C, rho_p, com,
-                         mass, inertia, w_rel, omega, alpha, r, v, a, r_G, v_G, a_G, JR, JT,
-                         g, Xc, w_rel_b, v_rel)
-        fm.JO = JO
-        return fm
+        return JR, JO, self.s(JO - _cross_columns(c, JR))
 
     def _driven(self, joint):
         return self.joint_values[joint.name][3]
@@ -416,13 +312,7 @@ class Walk:
             m.force = self.s(m.force + F)
             m.moment = self.s(m.moment + N + cross(lever, F))
 
-    # ------------------------------------------------------------------ force elements
-    def _param(self, el, key):
-        value = el.symbolic.get(key, el.params[key])
-        if isinstance(value, sympy.Basic):
-            return canonical(value, self.sym.table)
-        return exact(value)
-
+    # ------------------------------------------------------------------ world quantities
     def _world_point(self, frame, point):
         """World position of a point fixed on ``frame`` (own components)."""
         if frame == "ground":
@@ -464,141 +354,6 @@ class Walk:
         if frame == "ground":
             return p_world
         return self.s(self._R_world(frame).T * (p_world - self._world_point(frame, Z3)))
-
-    def _spin(self, name):
-        """The speed a bearing's coefficients depend on: a speed symbol, or a driven joint's
-        prescribed rate."""
-        for j in self.joints:
-            qj, uj, _, driven = self.joint_values[j.name]
-            if j.nu == 1 and (name == j.name or name in j.coordinates or name in j.speeds):
-                return uj[0]
-        raise ModelError(f"unknown spin speed {name!r}")
-
-    def _coefficient(self, el, key):
-        """A bearing coefficient: a number, or a table as a named function of the spin speed
-        (``kxx_bearing(spin)``) that evaluates by the table's interpolation."""
-        value = el.params[key]
-        if hasattr(value, "block"):                     # a Table
-            from sympy.utilities.lambdify import implemented_function
-            fn = implemented_function(f"{key}_{el.name}", value)
-            return fn(self._spin(el.params["speed"]))
-        return self._param(el, key)
-
-    def _apply_forces(self):
-        """Force elements as body wrenches, in closed form: a spring-damper's tension along
-        the line of its points, a joint spring-damper's effort on its coordinate, a bushing's
-        6x6 law, a bearing's eight coefficients (tabulated ones as named functions of the
-        spin speed), a contact's Hunt-Crossley force and regularised friction."""
-        for el in getattr(self.model, "_force_elements", ()):
-            p = el.params
-            tabulated = [k for k in ("force_table", "damping_table") if p.get(k) is not None]
-            if tabulated:
-                raise ModelError(f"force {el.name!r}: the symbolic layer writes linear springs "
-                                 "and dampers in closed form, not tabulated laws; switch it off "
-                                 f"to derive the rest (--effects=-{el.name})")
-            vec = lambda key: exact_vector(el.symbolic.get(key, p[key]), self.sym.table)  # noqa
-            law = p.get("law")
-            if law is not None and law.expression is None:
-                raise ModelError(f"force {el.name!r}: its law is a Python function; the symbolic "
-                                 "layer needs it as an expression of x and v (or switch it off: "
-                                 f"--effects=-{el.name})")
-            if el.kind == "spring-damper":
-                k, c, F0 = (self._param(el, key) for key in ("stiffness", "damping", "preload"))
-                pa, pb = vec("point_a"), vec("point_b")
-                a, b = el.frames
-                d = self._world_point(b, pb) - self._world_point(a, pa)
-                L = sympy.sqrt((d.T * d)[0])
-                x = L - self._param(el, "free_length")
-                T = (self._law(law, x, self.D(L)) if law is not None
-                     else F0 + k * x + c * self.D(L))
-                f = d * (T / L)
-                self._add_wrench(el.name, a, f, Z3, pa)
-                self._add_wrench(el.name, b, -f, Z3, pb)
-            elif el.kind == "joint-spring-damper":
-                k, c, F0 = (self._param(el, key) for key in ("stiffness", "damping", "preload"))
-                joint = next(j for j in self.joints if j.name == p["joint"])
-                qj, uj, _, driven = self.joint_values[joint.name]
-                x = qj[0] - self._param(el, "rest")
-                tau = -(self._law(law, x, uj[0]) if law is not None else F0 + k * x + c * uj[0])
-                m = self.by_name[joint.child]
-                axis = self._joint_geometry(joint)[0]
-                # the axis in world components: joint frame J0 = child axes along the axis
-                axis_w = self.s(self._R_world(joint.child) * axis)
-                if joint.kind == "revolute":
-                    self._add_wrench(el.name, joint.child, Z3, tau * axis_w, Z3)
-                    self._add_wrench(el.name, joint.parent, Z3, -tau * axis_w, Z3)
-                else:
-                    self._add_wrench(el.name, joint.child, tau * axis_w, Z3, Z3)
-                    if joint.parent != "ground":
-                        self._add_wrench(el.name, joint.parent, -tau * axis_w, Z3, m.rho_p)
-            elif el.kind == "bushing":
-                a, b = el.frames
-                pa, pb = vec("point_a"), vec("point_b")
-                Ra = self._R_world(a)
-                pbw = self._world_point(b, pb)
-                x = self.s(Ra.T * (pbw - self._world_point(a, pa)))
-                Rrel = self.s(Ra.T * self._R_world(b))
-                theta = sympy.Matrix([Rrel[2, 1] - Rrel[1, 2], Rrel[0, 2] - Rrel[2, 0],
-                                      Rrel[1, 0] - Rrel[0, 1]]) / 2
-                xd = self.s(self.D(x))
-                thd = self.s(Ra.T * (self._omega_world(b) - self._omega_world(a)))
-                K = sympy.Matrix(6, 6, [exact(v) for v in np.ravel(p["stiffness"])])
-                C = sympy.Matrix(6, 6, [exact(v) for v in np.ravel(p["damping"])])
-                w6 = -(K * x.col_join(theta) + C * xd.col_join(thd))
-                f, mo = self.s(Ra * w6[:3, 0]), self.s(Ra * w6[3:, 0])
-                self._add_wrench(el.name, b, f, mo, pb)
-                self._add_wrench(el.name, a, -f, -mo, self._own_point(a, pbw))
-            elif el.kind == "bearing":
-                a, b = el.frames
-                Rb = self._R_world(b)
-                e1, e2 = self.s(Rb * vec("e1")), self.s(Rb * vec("e2"))
-                pa = vec("point")
-                paw = self._world_point(a, pa)
-                d = paw - self._world_point(b, vec("center"))
-                x, y = (e1.T * d)[0], (e2.T * d)[0]
-                xd, yd = self.D(x), self.D(y)
-                kxx, kxy, kyx, kyy, cxx, cxy, cyx, cyy = (
-                    self._coefficient(el, c) for c in ("kxx", "kxy", "kyx", "kyy", "cxx",
-                                                        "cxy", "cyx", "cyy"))
-                fx = -(kxx * x + kxy * y + cxx * xd + cxy * yd)
-                fy = -(kyx * x + kyy * y + cyx * xd + cyy * yd)
-                f = self.s(e1 * fx + e2 * fy)
-                self._add_wrench(el.name, a, f, Z3, pa)
-                self._add_wrench(el.name, b, -f, Z3, self._own_point(b, paw))
-            else:                                           # contact
-                a = el.frames[0]
-                n = vec("plane_normal")
-                radius = self._param(el, "radius")
-                centre = self._world_point(a, vec("center"))
-                if p["shape"] == "disk":
-                    ax = self._R_world(a) * vec("axis")
-                    side = -n + (n.T * ax)[0] * ax
-                    pc = centre + radius * side / sympy.sqrt((side.T * side)[0])
-                else:
-                    pc = centre - radius * n
-                pc = self.s(pc)
-                delta = -((pc - vec("plane_point")).T * n)[0]
-                own = self._own_point(a, pc)
-                vc = self._world_velocity(a) + self._omega_world(a).cross(
-                    pc - self._world_point(a, Z3))
-                vn = (vc.T * n)[0]
-                k = self._param(el, "stiffness")
-                ex = self._param(el, "exponent")
-                chc = exact(p["damping_factor"])
-                fn = sympy.Max(0, k * delta ** ex * (1 - chc * vn))
-                vt = vc - vn * n
-                ft = -self._param(el, "friction") * fn / sympy.sqrt(
-                    (vt.T * vt)[0] + self._param(el, "slip_speed") ** 2)
-                f = (fn * n + ft * vt).applyfunc(
-                    lambda e: sympy.Piecewise((e, delta > 0), (0, True)))
-                self._add_wrench(el.name, a, f, Z3, own)
-
-    def _law(self, law, x, v):
-        """A law's expression with the elongation ``x`` and its rate ``v`` put in."""
-        e = law.expression
-        e = e.xreplace({s: (x if s.name == "x" else v) for s in e.free_symbols
-                        if s.name in ("x", "v")})
-        return canonical(e, self.sym.table)
 
     def _world_velocity(self, frame):
         """World velocity of a frame's origin."""
