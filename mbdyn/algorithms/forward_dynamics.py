@@ -10,6 +10,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..kernels import packed as kp
+from .loop_newton_euler import loop_newton_euler
 
 
 #: formulations of the forward dynamics: ``M(q) u' = f`` (Jourdain, composite-rigid-body
@@ -31,6 +32,10 @@ def forward_dynamics(model, q, u, t=0.0, method="jourdain"):
     reactions, eliminated in tree order (``"newton-euler"``) or assembled dense and
     solved by LU (``"newton-euler-dense"``).  All four solve the same equations;
     ``docs/performance.md`` says which is fastest at which size."""
+    if model._con is not None and method in ("jourdain", "articulated"):
+        return model._constrained_accelerations(q, u, t)     # closed loops: G u' = gamma
+    if model._con is not None and method in ("newton-euler", "newton-euler-dense"):
+        return loop_newton_euler(model, q, u, t)[0]
     if method in ("jourdain", "articulated"):
         q, u = model._state(q, u)
         if model._python_inputs:
@@ -55,7 +60,10 @@ def formulation(model, method="auto"):
     """The per-call route ``method`` stands for: ``"auto"`` is ``"jourdain"`` for fewer
     than ``ARTICULATED_FROM`` free speeds, else ``"articulated"`` (measured crossover,
     docs/performance.md); any other name is checked and returned."""
-    if method == "auto":
+    if method == "auto" or (method == "articulated" and model._con is not None):
+        # closed loops: M u' = f + G^T lam by the mass matrix (kernels.constrained)
+        if model._con is not None:
+            return "jourdain"
         return "jourdain" if model.nu < ARTICULATED_FROM else "articulated"
     if method not in METHODS:
         raise ModelError(f"unknown method {method!r}; use 'auto' or one of "
@@ -75,6 +83,12 @@ def state_derivative(model, t, y, method="jourdain"):
     if y.shape != (model.nq + model.nu,):
         raise ModelError(f"model {model.name!r} expects a state of length "
                          f"{model.nq + model.nu} (q then u), got shape {y.shape}")
+    if model._con is not None:
+        ydot = np.empty(model.nq + model.nu)
+        q, u = y[:model.nq], y[model.nq:]
+        ydot[model.nq:] = model._constrained_accelerations(q, u, t)
+        ydot[:model.nq] = model.coordinate_rates(q, u)
+        return ydot
     if method == "jourdain":
         kernel = kp.state_derivative_packed
     elif method == "articulated":

@@ -10,6 +10,8 @@ import numpy as np
 from ..errors import ModelError
 from ..kernels import dynamics as kd
 from .forward_dynamics import ARTICULATED_FROM, METHODS
+from .loop_newton_euler import loop_newton_euler_reactions
+from .loop_reactions import child_rotation, loop_reactions
 
 
 def reactions(model, q, u, t=0.0, method="auto", frame="world"):
@@ -27,6 +29,15 @@ def reactions(model, q, u, t=0.0, method="auto", frame="world"):
     """
     if frame not in ("world", "child"):
         raise ModelError(f"unknown frame {frame!r} for reactions; use 'world' or 'child'")
+    if model._con is not None:        # closed loops: with the loop joints' multipliers
+        if method in ("newton-euler", "newton-euler-dense"):
+            out = loop_newton_euler_reactions(model, q, u, t)[1]
+            if frame == "child":
+                out = {name: (child_rotation(model, name).T @ f,
+                              child_rotation(model, name).T @ m)
+                       for name, (f, m) in out.items()}
+            return out
+        return loop_reactions(model, q, u, t, frame)
     if method == "auto":
         method = "newton-euler-dense" if model.nu < ARTICULATED_FROM else "newton-euler"
     if method in ("newton-euler", "newton-euler-dense"):

@@ -23,6 +23,7 @@ from ..elements.loads import make_load
 from ..errors import ModelError, ModelWarning, SingularMassMatrixError
 from ..limits import magnitude_problem
 from ..names import identifier_problem, label_problem
+from .loops import add_loop_joint, check_loops, loop_bodies
 from ..elements.forces import GLOBAL_EFFECTS, make_force
 
 GROUND = "ground"
@@ -71,6 +72,7 @@ class System:
         self.graph = nx.DiGraph()
         self.graph.add_node(GROUND, body=make_body(GROUND))
         self._joints = {}
+        self._loop_joints = {}          # name -> LoopJoint (assembly.loops)
         self._loads = {}
         self._forces = {}
 
@@ -131,8 +133,9 @@ class System:
         self.graph.add_node(name, body=make_body(name, shape=shape))
         return name
 
-    def add_joint(self, name, kind, parent, child, *, axis=None, position=(0, 0, 0),
-                  orientation=None, sequence=None, coordinates=None, speeds=None, drive=None):
+    def add_joint(self, name, kind, parent=None, child=None, *, axis=None,
+                  position=(0, 0, 0), orientation=None, sequence=None, coordinates=None,
+                  speeds=None, drive=None, **loop):
         """Join ``child`` to ``parent``.
 
         ``kind``: ``"revolute"`` / ``"prismatic"`` (need ``axis``, a vector or
@@ -143,12 +146,24 @@ class System:
         or ``(axis, angle)``).  ``coordinates`` (and ``speeds``) name the joint's
         coordinates; ``drive`` prescribes ``q(t)`` of a 1-DoF joint (a sympy expression of
         ``mb.t`` or three callables ``(q, q', q'')``).
+
+        A joint given ``child_position`` (the joint's point in the child's body frame), or
+        ``cut=True``, closes a loop (``assembly.loops``): kinds revolute, prismatic,
+        spherical, fixed, ``universal`` (``axis`` in the parent's joint frame, ``axis2`` in
+        the child's), ``cylindrical``, plus ``"distance"`` (``length``: a massless rod
+        between ``position`` on the parent and ``child_position`` on the child) and
+        ``"coupling"`` (``follower``, ``leader``, ``ratio``, ``offset``: ``q_follower =
+        ratio q_leader + offset``; no parent or child).  ``child_orientation`` places the
+        joint frame in the child.
         """
+        if loop or kind in ("distance", "coupling"):
+            return add_loop_joint(self, name, kind, parent, child, axis=axis,
+                                  position=position, orientation=orientation, **loop)
         element = f"joint {name!r}"
         problem = label_problem(name)
         if problem:
             raise ModelError(f"joint name {name!r} {problem}")
-        if name in self._joints:
+        if name in self._joints or name in self._loop_joints:
             raise ModelError(f"{element}: the name is already used by another joint")
         for role, frame in (("parent", parent), ("child", child)):
             if frame not in self.graph:
@@ -162,8 +177,9 @@ class System:
         existing = next(iter(self.graph.in_edges(child, data="joint")), None)
         if existing is not None:
             raise ModelError(f"{element}: frame {child!r} already has a parent joint "
-                             f"{existing[2].name!r}; closed loops are not supported -- a "
-                             "frame hangs from exactly one joint")
+                             f"{existing[2].name!r}; to close a loop, give this joint "
+                             f"child_position (the joint's point in {child!r}'s body "
+                             "frame), and it becomes a loop joint")
         if nx.has_path(self.graph, child, parent):
             raise ModelError(f"{element}: joining {parent!r} -> {child!r} closes a cycle "
                              f"({child!r} is already an ancestor of {parent!r}); the system "
@@ -274,6 +290,7 @@ class System:
         """
         state = parse_effects(effects, self.effect_names())
         warn_if_unphysical(state, self.name)
+        loop_joints = check_loops(self)
         order = self.topological_frames()
         if not order:
             raise ModelError(f"system {self.name!r} has no bodies; add bodies and joints")
@@ -290,9 +307,10 @@ class System:
                       warnings=found, parameters=self.parameters,
                       gravity_symbolic=self.gravity_symbolic if state["gravity"] else None,
                       forces=[el for el in self._forces.values() if state[el.name]],
-                      effects=state)
-        if check_inertia and model.nu:
+                      effects=state, loop_joints=loop_joints)
+        if check_inertia and model.nu and not loop_joints:
             _check_inertia_of_every_dof(model)
+        model.loops = {j.name: loop_bodies(self, j) for j in loop_joints}
         return model
 
 

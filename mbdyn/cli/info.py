@@ -38,6 +38,8 @@ def describe(scene):
                        "massless": not b.has_inertia})
     joints, drives = [], []
     for spec in scene.joint_specs:
+        if spec["name"] in model.loop_joints:
+            continue                       # described under "loops"
         j = model.joint(spec["name"])
         entry = {"name": j.name, "kind": j.kind, "parent": j.parent, "child": j.child,
                  "coordinates": list(j.coordinates), "speeds": list(j.speeds),
@@ -74,7 +76,37 @@ def describe(scene):
         "simulation": dict(scene.settings),
         "outputs": outputs_spec(scene),
         "warnings": list(scene.warnings),
+        "loops": describe_loops(scene) if model.has_loops else None,
     }
+
+
+def describe_loops(scene):
+    """The loop joints, the loops they close, the constraint equations, their rank at the
+    initial state, the mobility and the reaction components that are not unique."""
+    from ..integrate.result import REACTION_COMPONENTS
+    model = scene.model
+    rank, conditioning = model.constraint_rank(scene.q0)
+    joints = []
+    for name in model.loop_joints:
+        j = model.joint(name)
+        entry = {"name": name, "kind": j.kind, "equations": j.equations}
+        if j.kind == "coupling":
+            entry.update(follower=j.follower, leader=j.leader, ratio=j.ratio, offset=j.offset)
+        else:
+            entry.update(parent=j.parent, child=j.child, position=j.position.tolist(),
+                         child_position=j.child_position.tolist(),
+                         loop=list(model.loops.get(name, [])))
+            if j.kind == "distance":
+                entry["length"] = j.length
+        joints.append(entry)
+    unique = model.reaction_uniqueness(scene.q0)
+    m = len(model.constraint_rows)
+    return {"joints": joints, "equations": m, "rank": rank, "redundant": m - rank,
+            "mobility": model.nu - rank, "grubler_mobility": model.nu - m,
+            "conditioning": conditioning,
+            "reactions_not_unique": {
+                j: [c for c, ok in zip(REACTION_COMPONENTS, flags) if not ok]
+                for j, flags in unique.items() if not flags.all()}}
 
 
 def info(args):
@@ -84,7 +116,8 @@ def info(args):
         sys.stdout.write(json.dumps(d) + "\n")
         return 0
     w = sys.stdout.write
-    for section in (_model, _bodies, _joints, _states, _loads, _run_settings, _outputs):
+    for section in (_model, _bodies, _joints, _loops, _states, _loads, _run_settings,
+                    _outputs):
         section(d, w)
     return 0
 
@@ -134,11 +167,40 @@ def _joints(d, w):
         w(f"  {j['name']:<14} {j['kind']}{extra}, {j['parent']} -> {j['child']}; {what}\n")
 
 
+def _loops(d, w):
+    """Loop joints, equations, rank (numerical, at the initial state), mobility."""
+    lp = d["loops"]
+    if not lp:
+        return
+    w(f"loops ({len(lp['joints'])} loop joints)\n")
+    for j in lp["joints"]:
+        if j["kind"] == "coupling":
+            w(f"  {j['name']:<14} coupling: {j['follower']} = {fmt(j['ratio'])} * "
+              f"{j['leader']} + {fmt(j['offset'])}; 1 equation\n")
+            continue
+        extra = f" length {fmt(j['length'])}" if "length" in j else ""
+        w(f"  {j['name']:<14} {j['kind']}{extra}, {j['parent']} at {_text(j['position'])} "
+          f"-> {j['child']} at {_text(j['child_position'])}; {j['equations']} equations; "
+          f"closes {' - '.join(j['loop'])}\n")
+    w(f"  constraint equations {lp['equations']}, rank {lp['rank']} "
+      f"({lp['redundant']} redundant; rank from the singular values of G above 1e-9 of the "
+      f"largest), mobility {lp['mobility']} degree(s) of freedom (Gruebler's count: "
+      f"{lp['grubler_mobility']})\n")
+    if lp["reactions_not_unique"]:
+        w("  reactions not unique (minimum-norm values reported): "
+          + "; ".join(f"{j} {', '.join(c)}" for j, c in lp["reactions_not_unique"].items())
+          + "\n")
+
+
 def _states(d, w):
     """Coordinates, speeds, degrees of freedom and drives."""
     w(f"coordinates  {', '.join(d['coordinates']) or '(none)'}\n")
     w(f"speeds       {', '.join(d['speeds']) or '(none)'}\n")
-    w(f"degrees of freedom  {d['dof']}\n")
+    if d.get("loops"):
+        w(f"degrees of freedom  {d['loops']['mobility']} ({d['dof']} free speeds, less the "
+          f"rank {d['loops']['rank']} of the loop constraints)\n")
+    else:
+        w(f"degrees of freedom  {d['dof']}\n")
     w("drives       " + ("; ".join(f"{x['joint']}: {x['coordinate']} = {x['expression']}"
                                    for x in d["drives"]) or "none") + "\n")
 

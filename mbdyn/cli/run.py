@@ -106,5 +106,17 @@ def report(scene, result, paths):
     if s["energy"]:
         e0, e1 = s["energy"]["initial"], s["energy"]["final"]
         out.write(f"  energy T + V: initial {fmt(e0)} J, final {fmt(e1)} J\n")
+    if s.get("loops"):
+        lp = s["loops"]
+        out.write(f"  loops: mobility {lp.get('mobility')}, constraint drift "
+                  f"{fmt(lp.get('constraint_drift', 0.0))} (positions), "
+                  f"{fmt(lp.get('constraint_drift_velocity', 0.0))} (velocities)\n")
+        if lp.get("reactions_not_unique"):
+            out.write("  reactions not unique (minimum-norm values): " + "; ".join(
+                f"{j} {', '.join(c)}" for j, c in lp["reactions_not_unique"].items()) + "\n")
+        if lp.get("singular_configuration"):
+            sc = lp["singular_configuration"]
+            out.write(f"  singular configuration passed at t = {fmt(sc['t'])} s (rank "
+                      f"{sc['rank']})\n")
     for p in paths:
         out.write(f"  wrote {p}\n")

@@ -11,6 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..kernels import evaluate as ke
+from ..kernels.constraints import constraint_count
+from .constraint_packing import pack_constraints
 from ..kernels import packed as kp
 
 
@@ -242,3 +244,22 @@ def argument_groups(model):
                            model._force_data, model._switches)
     model._kin_out = (model._R, model._r, model._w, model._v, model._alpha, model._a,
                       model._JR, model._JT, model._F, model._N)
+
+
+def constraints(model, loop_joints):
+    """The loop joints' primitive constraints (``compiled.constraint_packing``) and their
+    workspace: ``model._con = (con_int, con_data, phi, psi, G, gamma, lam, info)``, or
+    None for a tree."""
+    model.loop_joints = tuple(j.name for j in loop_joints)
+    model._loop_joint = {j.name: j for j in loop_joints}
+    if not loop_joints:
+        model._con = None
+        model.constraint_rows = ()
+        model._row_joint = model._prim_joint = ()
+        return
+    con_int, con_data, labels, owners, prim_owner = pack_constraints(model, loop_joints)
+    m = constraint_count(con_int)
+    model.constraint_rows = labels
+    model._row_joint, model._prim_joint = owners, prim_owner
+    model._con = (con_int, con_data, np.zeros(m), np.zeros(m), np.zeros((m, model.nu)),
+                  np.zeros(m), np.zeros(m), np.zeros(2))

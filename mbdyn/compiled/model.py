@@ -14,7 +14,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..algorithms import diagnosis, inputs, jourdain
+from ..algorithms import closure, diagnosis, inputs, jourdain
+from ..algorithms import constrained as loops
+from ..algorithms import loop_reactions as loop_reaction
 from ..algorithms import energy as energies
 from ..algorithms import forward_dynamics as forward
 from ..algorithms import kinematics as motion
@@ -33,7 +35,7 @@ class Model:
     """
 
     def __init__(self, name, bodies, joints, loads, gravity, warnings=(), parameters=None,
-                 gravity_symbolic=None, forces=(), effects=None):
+                 gravity_symbolic=None, forces=(), effects=None, loop_joints=()):
         self.name = name
         self.warnings = tuple(warnings)
         self.gravity = np.array(gravity, dtype=float)
@@ -74,6 +76,7 @@ class Model:
         #: evaluation
         self._python_inputs = bool(self._driven or self._load_functions or self._laws)
         layout.argument_groups(self)
+        layout.constraints(self, loop_joints)
 
     def __repr__(self):
         return (f"<Model {self.name!r}: {self.n_frames} frames, {len(self.joints)} joints, "
@@ -81,8 +84,16 @@ class Model:
 
     # ------------------------------------------------------------------ names and records
     def joint(self, name):
-        """The joint record (kind, axis, parent, child, coordinates, drive...)."""
+        """The joint record (kind, axis, parent, child, coordinates, drive...); a loop
+        joint's record (``elements.constraints.LoopJoint``) too."""
+        if isinstance(name, str) and name in self._loop_joint:
+            return self._loop_joint[name]
         return _look_up(self._joint, name, "joint", "joints", self.joints)
+
+    @property
+    def has_loops(self):
+        """True when loop joints close the tree (constraint equations)."""
+        return self._con is not None
 
     def body(self, name):
         """The body record (mass, com, inertia about the centre of mass)."""
@@ -174,6 +185,21 @@ class Model:
     element_energy = energies.element_energy
     load_power = energies.load_power
     euler_singularity = diagnosis.euler_singularity
+    # closed loops (``algorithms.constrained``, ``algorithms.closure``)
+    constraint_residuals = loops.constraint_residuals
+    constraint_jacobian = loops.constraint_jacobian
+    constraint_rank = loops.constraint_rank
+    mobility = loops.mobility
+    multipliers = loops.multipliers
+    project = loops.project
+    assemble = closure.assemble
+    reaction_uniqueness = loop_reaction.reaction_uniqueness
+
+    @property
+    def reaction_joints(self):
+        """The joints that have reactions: the tree's, then the loop joints'."""
+        return loop_reaction.reaction_joints(self) if self._con is not None else self.joints
+    _constrained_accelerations = loops.constrained_accelerations
     mass_matrix_condition = diagnosis.mass_matrix_condition
 
     def _dense_system(self):
@@ -219,7 +245,9 @@ class Model:
         ws = (self._qfull, self._ufull, self._udfull, self._R, self._r, self._w, self._v,
               self._alpha, self._a, self._JR, self._JT, self._F, self._N)
         tree = self._tree
-        if method == "jourdain":
+        if method == "jourdain" and self._con is not None:
+            ws += (self._M, self._f, self._L, self._scratch, self._con)   # closed loops
+        elif method == "jourdain":
             ws += (self._M, self._f, self._L, self._scratch)
         elif method == "articulated":
             ws += (self._IA, self._pA, self._cb, self._U, self._Dl, self._acc, self._scratch)

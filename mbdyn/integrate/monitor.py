@@ -122,4 +122,8 @@ LOOP_STATUS = {
     2: lambda m: SingularMassMatrixError("the mass matrix is not positive definite"),
     3: lambda m: NonFiniteError("the implicit midpoint's Newton iteration did not converge; "
                                 "reduce dt"),
+    5: lambda m: NonFiniteError("the state could not be projected back onto the loop "
+                                "constraints (the mechanism may be passing a singular "
+                                "configuration, or the step is too large): reduce dt or the "
+                                "tolerances"),
 }

@@ -11,6 +11,10 @@ from .balance import energy_balance
 from .settings import OUTPUTS
 
 
+#: the six components of a reaction, in its columns' order
+REACTION_COMPONENTS = ("Fx", "Fy", "Fz", "Mx", "My", "Mz")
+
+
 class Result:
     """Time series of a simulation.
 
@@ -131,7 +135,7 @@ class Result:
             raise ModelError(f"unknown outputs {sorted(unknown)}; choose from {OUTPUTS}")
         n = len(self.t)
         if "reactions" in outputs:
-            reac = {j: np.empty((n, 6)) for j in model.joints}
+            reac = {j: np.empty((n, 6)) for j in model.reaction_joints}
             efforts = {j: np.empty(n) for j in model.driven_joints}
             for k in range(n):
                 r = model.reactions(self.q[k], self.u[k], self.t[k], method=method,
@@ -143,6 +147,11 @@ class Result:
                     efforts[j][k] = val
             self.reactions = reac
             self.drive_efforts = efforts
+            if model.has_loops and n:
+                unique = model.reaction_uniqueness(self.q[0], self.t[0])
+                self.stats["reactions_not_unique"] = {
+                    j: [c for c, ok in zip(REACTION_COMPONENTS, flags) if not ok]
+                    for j, flags in unique.items() if not flags.all()}
         if "energy" in outputs:
             self.energy = energy_balance(model, self.t, self.q, self.u)
             E = self.energy["balance"]

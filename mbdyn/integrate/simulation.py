@@ -21,6 +21,7 @@ from ..compiled.force_packing import warn_outside_tables
 from ..errors import ModelError, ModelWarning, SimulationError
 from . import compiled_adaptive, fixed_step, scipy_solvers
 from .budget import check_fixed_step, make_budget
+from .closed_loops import closed_initial_state, loop_report
 from .events import Event, as_event, check_conditions
 from .monitor import Monitor, conditioning
 from .plan import Plan, RightHandSide
@@ -81,6 +82,8 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     budget["integrator"] = integrator
     t_eval = _check_t_eval(t_eval, t0, t_end)
     q, u = _initial_state(model, q0, u0)
+    if model.has_loops:
+        q, u = closed_initial_state(model, q, u, t0)
     events = [as_event(e, model) for e in events]
     if events:
         check_conditions(events, model, t0, q, u)
@@ -110,6 +113,8 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     stats = {"integrator": integrator, "method": method, "rtol": rtol, "atol": atol, "dt": dt,
              "rhs_evaluations": rhs.evaluations, "wall_time_s": _time.perf_counter() - start}
     result = _result(model, outcome, stats, pre_stats, monitor)
+    if model.has_loops:
+        loop_report(model, result)
     if outputs or points:
         result.compute_outputs(outputs, points, frame=reactions_frame)
     return result

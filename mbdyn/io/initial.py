@@ -21,6 +21,13 @@ def read_initial(b):
     q0 = b.model.q_vector(dict(q)).copy()
     u0 = b.model.u_vector(dict(u)).copy()
     _normalise_quaternions(b, q0)
+    if b.model.has_loops:             # hold what the file gives, solve the rest
+        guess = _guess(b, driven, q)
+        with b.engine(("initial",)):
+            q0, u0 = b.model.assemble(dict(q), dict(u), guess)
+    elif b.doc.get("guess"):
+        raise b.error(("guess",), "a [guess] table starts the assembly of closed loops; "
+                      "this model has no loop joints -- remove it or use [initial]")
     initial = dict(q)
     initial.update(u)
     return q0, u0, initial
@@ -101,3 +108,23 @@ def _normalise_quaternions(b, q0):
                               f"({', '.join(names)}) has length {norm:.6g}; it is "
                               "normalised to unit length", ModelWarning)
                 q0[idx] = q0[idx] / norm
+
+
+def _guess(b, driven, held):
+    """``[guess]``: starting values of the coordinates the assembly solves for."""
+    model = b.model
+    out = {}
+    for k, v in b.doc.get("guess", {}).items():
+        path = ("guess", k)
+        if k not in model.coordinates:
+            if k in driven:
+                raise b.error(path, f"is the coordinate of driven joint {driven[k]!r}; the "
+                              "drive gives it -- remove it here")
+            raise b.error(path, f"{k!r} is not a coordinate of the model; "
+                          f"{suggest(k, model.coordinates)}the coordinates are: "
+                          f"{', '.join(model.coordinates) or '(none)'}")
+        if k in held:
+            raise b.error(path, f"{k!r} is also in [initial], which holds it; a guess is "
+                          "for the coordinates the assembly solves -- keep one of the two")
+        out[k] = b.number(v, path)
+    return out

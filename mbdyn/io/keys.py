@@ -12,11 +12,19 @@ BODY_KEYS = {"name": "name", "mass": "expr", "com": "vector", "inertia": "inerti
 SHAPE_KEYS = {"type": ("choice", ("sphere", "box", "cylinder", "disk", "rod")),
               "radius": "expr", "length": "expr", "size": "vector", "center": "vector",
               "start": "vector", "end": "vector", "axis": "axis", "color": "string"}
-JOINT_KINDS = ("revolute", "prismatic", "euler", "spherical", "fixed", "free")
+JOINT_KINDS = ("revolute", "prismatic", "euler", "spherical", "fixed", "free", "universal",
+               "cylindrical", "distance", "coupling")
 JOINT_KEYS = {"name": "name", "kind": ("choice", JOINT_KINDS), "parent": "name",
               "child": "name", "axis": "axis", "position": "vector",
               "orientation": "orientation", "sequence": "string", "coordinates": "names",
-              "speeds": "names", "drive": "expr"}
+              "speeds": "names", "drive": "expr",
+              # loop joints (docs/constraints.md)
+              "child_position": "vector", "child_orientation": "orientation", "cut": "bool",
+              "axis2": "axis", "length": "expr", "follower": "name", "leader": "name",
+              "ratio": "expr", "offset": "expr"}
+#: the keys that make a joint a loop joint
+LOOP_JOINT_KEYS = ("child_position", "child_orientation", "cut", "axis2", "length",
+                   "follower", "leader", "ratio", "offset")
 LOAD_KEYS = {"name": "name", "body": "name", "force": "vector", "moment": "vector",
              "point": "vector", "frame": ("choice", ("world", "body"))}
 SIMULATION_KEYS = {"t_end": "expr", "integrator": "string", "method": "string",
@@ -58,6 +66,7 @@ SECTIONS = {
     "effects": ("table", EFFECT_KEYS),
     "initial": ("map", None),
     "initial_speeds": ("map", None),
+    "guess": ("map", None),
     "simulation": ("table", SIMULATION_KEYS),
     "outputs": ("table", OUTPUT_KEYS),
     "events": ("array", EVENT_KEYS),

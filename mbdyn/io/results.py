@@ -47,7 +47,8 @@ def summary(scene, result):
          "reactions": {joint: [Fx, Fy, Fz, Mx, My, Mz]}|null,   (at t_final, as requested)
          "drive_efforts": {joint: float}|null, "points": {name: [x, y, z]}|null,
          "stats": {"integrator": str, "method": str, "steps": int,
-                   "rhs_evaluations": int, "wall_time_s": float}}
+                   "rhs_evaluations": int, "wall_time_s": float},
+         "loops": {...}}          (closed mechanisms only: ``loop_summary``)
     """
     model = scene.model
     energy = None
@@ -55,7 +56,7 @@ def summary(scene, result):
         total = result.energy["total"]
         energy = {"initial": _float(total[0]), "final": _float(total[-1])}
     st = result.stats
-    return {
+    out = {
         "model": scene.name,
         "case": scene.case,
         "t_final": _float(result.t[-1]),
@@ -75,6 +76,22 @@ def summary(scene, result):
                   "rhs_evaluations": int(st.get("rhs_evaluations", 0)),
                   "wall_time_s": _float(st.get("wall_time_s", 0.0))},
     }
+    if model.has_loops:
+        out["loops"] = loop_summary(result)
+    return out
+
+
+def loop_summary(result):
+    """What a closed mechanism's run kept: its constraints' drift, their rank and the
+    mobility, the reactions that are not unique, a singular configuration passed."""
+    st = result.stats
+    out = {k: st[k] for k in ("constraint_rank", "mobility", "reactions_not_unique",
+                              "singular_configuration") if k in st}
+    for k in ("constraint_drift", "constraint_drift_velocity", "constraint_drift_unprojected",
+              "constraint_conditioning_min"):
+        if k in st:
+            out[k] = _float(st[k])
+    return out
 
 
 def reaction_series(scene, result):
@@ -86,10 +103,13 @@ def reaction_series(scene, result):
     out = {j: np.array(result.reactions[j]) for j in wanted if j in result.reactions}
     if scene.outputs["reactions_frame"] == "child" and out:
         model = scene.model
-        child = {j: model.frame_index(model.joint(j).child) for j in out}
+        child = {j: model.frame_index(model.joint(j).child) for j in out
+                 if model.joint(j).child != "ground"}
         for k in range(len(result.t)):
             kin = model.kinematics(result.q[k], result.u[k], t=result.t[k])
             for j, arr in out.items():
+                if j not in child:          # a loop joint onto the ground: world axes
+                    continue
                 RT = kin.R[child[j]].T
                 arr[k, :3] = RT @ arr[k, :3]
                 arr[k, 3:] = RT @ arr[k, 3:]

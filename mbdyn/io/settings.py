@@ -84,15 +84,15 @@ def read_outputs(b):
     path = ("outputs",)
     reactions = out.get("reactions", False)
     if reactions is True:
-        reactions = list(model.joints)
+        reactions = list(model.reaction_joints)
     elif reactions is False:
         reactions = []
     else:
         for k, jn in enumerate(reactions):
-            if jn not in model.joints:
+            if jn not in model.reaction_joints:
                 raise b.error(path + ("reactions", k), f"{jn!r} is not a joint; "
-                              f"{suggest(jn, model.joints)}the joints are: "
-                              f"{', '.join(model.joints)}")
+                              f"{suggest(jn, model.reaction_joints)}the joints are: "
+                              f"{', '.join(model.reaction_joints)}")
     points = {}
     for pname, p in out.get("points", {}).items():
         ppath = path + ("points", pname)

@@ -11,6 +11,7 @@ from .. import limits
 from ..assembly.system import GROUND
 from ..elements.expansion import expanded_terms
 from .expressions import ExpressionError, symbol, to_float
+from .keys import LOOP_JOINT_KEYS
 from .wording import suggest
 
 
@@ -77,6 +78,11 @@ def add_joints(b):
     specs = []
     for path, j, name in b.entries("joints", "joint"):
         kind = b.required(j, "kind", path, "joint")
+        loop = {k: j[k] for k in LOOP_JOINT_KEYS if k in j}
+        if kind == "coupling" or loop or kind == "distance":
+            add_loop_joint(b, path, j, name, kind, loop)
+            specs.append(dict(j))
+            continue
         child = b.required(j, "child", path, "joint")
         parent = j.get("parent", GROUND)
         _check_frames(b, path, parent, child)
@@ -102,6 +108,39 @@ def add_joints(b):
         _check_added_joint(b, b.system.joints[name], path)
         specs.append(dict(j))
     return specs
+
+
+def add_loop_joint(b, path, j, name, kind, loop):
+    """A joint that closes a loop (``child_position`` ...), a distance or a coupling."""
+    parent = child = None
+    if kind != "coupling":
+        child = b.required(j, "child", path, "joint")
+        parent = j.get("parent", GROUND)
+        _check_frames(b, path, parent, child)
+    for key in ("child_position",):
+        if key in loop:
+            loop[key] = b.pvector(loop[key], path + (key,))
+    if "child_orientation" in loop:
+        loop["child_orientation"] = _orientation(b, loop["child_orientation"],
+                                                 path + ("child_orientation",))
+    for key in ("length", "ratio", "offset"):
+        if key in loop:
+            loop[key] = b.pval(loop[key], path + (key,))
+    for key in ("axis", "axis2"):
+        if isinstance(j.get(key), list):
+            loop[key] = b.pvector(j[key], path + (key,))
+        elif key in j:
+            loop[key] = j[key]
+    for key in ("drive", "sequence", "coordinates", "speeds"):
+        if key in j:
+            raise b.error(path + (key,), f"a loop joint has no coordinates of its own: "
+                          f"remove {key} (it belongs on a tree joint)")
+    position = b.pvector(j.get("position"), path + ("position",)) if "position" in j \
+        else (0, 0, 0)
+    orientation = _orientation(b, j.get("orientation"), path + ("orientation",))
+    with b.engine(path):
+        b.system.add_joint(name, kind, parent, child, position=position,
+                           orientation=orientation, **loop)
 
 
 def _check_frames(b, path, parent, child):

@@ -29,7 +29,7 @@ import numpy as np
 from numba import njit
 
 from .events import step_ends_stretch
-from .integrators import _rhs
+from .integrators import _rhs, finish_step
 from .programs import STACK, drive_values
 from .views import untracked
 
@@ -279,8 +279,10 @@ def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_s
     ``events``: the event conditions (``kernels.events``), checked after every step; the
     stretch ends early after a step where one crossed zero or is not finite.
     On failure ``fail`` holds the stage's time, then its state.  Returns
-    ``(accepted, status, h_abs, i_eval)``; ``quats`` is unused (no projection: the drift is
-    reported, as with scipy's solvers)."""
+    ``(accepted, status, h_abs, i_eval)``.  A tree's ``quats`` are not projected (the drift
+    is reported, as with scipy's solvers); a closed mechanism's state is projected onto its
+    constraints after every accepted step (``integrators.finish_step``), and its
+    derivative evaluated again there."""
     # long: one compiled loop over accepted steps (stages, error norm, step control, dense
     # output, events): split into helpers numba must inline, it compiled 4 s longer cold on
     # the 2-core machine for no speed (measured for issue 23), and not inlined it pays a call
@@ -298,6 +300,7 @@ def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_s
     keep_stages = out_K.shape[0]
     check_events = events[3].shape[0] > 0
     exponent = -1.0 / (5.0 if kind == RK45 else 8.0)
+    constrained = len(ws) == 18
     accepted = 0
     while accepted < max_accept and t < t_end:
         min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
@@ -388,6 +391,19 @@ def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_s
             while i_eval < t_eval.shape[0] and t_eval[i_eval] <= t_new:
                 _dense_value(F, y, (t_eval[i_eval] - t) / h, samples[i_eval])
                 i_eval += 1
+        if constrained:      # a closed mechanism: back onto the constraint manifold
+            if dv.shape[0]:
+                drive_values(ops, consts, starts, t_new, stack, dv)
+            st = finish_step(y_new, dv, nq, slots, quats, free_q, free_u, drive_q, drive_u,
+                             tree, ws)
+            if st == 0:
+                st = _stage(t_new, y_new, ops, consts, starts, stack, dv, nq, slots, free_q,
+                            free_u, drive_q, drive_u, tree, body, loads, ws, K[stages - 1],
+                            nfev)
+            if st:
+                fail[0] = t_new
+                fail[1:] = y_new
+                return accepted, st, h_abs, i_eval
         if keep_stages:
             row = min(accepted, keep_stages - 1)
             for s in range(stages):

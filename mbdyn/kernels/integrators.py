@@ -16,11 +16,9 @@ positive definite, 3 implicit midpoint's Newton iteration did not converge.
 """
 import numpy as np
 from numba import njit
-from numba.extending import overload
-
-from .evaluate import articulated_accelerations, jourdain_accelerations
 from .events import step_ends_stretch
 from .joints import coordinate_rates
+from .routes import accelerations, finish_step
 from .views import untracked
 
 EULER, SEMI_IMPLICIT_EULER, RK4, IMPLICIT_MIDPOINT = 0, 1, 2, 3
@@ -34,37 +32,6 @@ STAGES = (0.0, 0.5, 1.0)
 def _rates(y, nq, slots, out):
     """``q' = N(q) u`` into ``out[:nq]``."""
     coordinate_rates(y[:nq], y[nq:], slots, out[:nq])
-
-
-def accelerations(tree, body, loads, ws, ud):
-    """``ud = u'`` by the route the workspace ``ws`` is laid out for (see
-    ``_accelerations_route``); returns as ``evaluate.jourdain_accelerations``."""
-    raise NotImplementedError("compiled code only")
-
-
-@overload(accelerations, inline="always")
-def _accelerations_route(tree, body, loads, ws, ud):
-    """The formulation is chosen when the loop is compiled, by the workspace's type: 17
-    arrays (``M``, ``f``, ``L``, scratch last) for ``M u' = f``, 20 (the articulated-body
-    workspace, then the scratch; ``tree`` then lists each frame's own speed columns) for
-    the articulated-body algorithm.  A run compiles only its own route."""
-    if len(ws) == 17:
-        def jourdain_route(tree, body, loads, ws, ud):
-            (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, F, N, M, f, L, scratch) = ws
-            return jourdain_accelerations(tree, body, (qfull, ufull, udfull), loads,
-                                          (R, r, w, v, alpha, a, JR, JT, F, N), (M, f, L, ud),
-                                          scratch)
-        return jourdain_route
-
-    def articulated_route(tree, body, loads, ws, ud):
-        (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, F, N, IA, pA, cb, U, Dl,
-         acc, scratch) = ws
-        mass, com, inertia, _, gravity = body
-        return articulated_accelerations(tree, (mass, com, inertia, gravity),
-                                         (qfull, ufull, udfull), loads,
-                                         (R, r, w, v, alpha, a, JR, JT, F, N),
-                                         (IA, pA, cb, U, Dl, acc), ud, scratch)
-    return articulated_route
 
 
 @njit(cache=True, inline="always")
@@ -100,15 +67,6 @@ def _copy(src, dst):
     shape-mismatch message: string formatting, seconds of a first run)."""
     for k in range(src.shape[0]):
         dst[k] = src[k]
-
-
-@njit(cache=True, inline="always")
-def _normalize(y, quats):
-    for s in range(quats.shape[0]):
-        i = quats[s]
-        n = np.sqrt(y[i] ** 2 + y[i + 1] ** 2 + y[i + 2] ** 2 + y[i + 3] ** 2)
-        for k in range(4):
-            y[i + k] /= n
 
 
 # Each scheme's step (inlined into the loops: no compiled layer of its own) has the same
@@ -212,7 +170,10 @@ def euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, dr
                         drive_q, drive_u, tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
         if st:
             return n, st
-        _normalize(out[n + 1], quats)
+        st = finish_step(out[n + 1], drive_table[n][2], nq, slots, quats, free_q, free_u,
+                         drive_q, drive_u, tree, ws)
+        if st:
+            return n, st
         if check_events and step_ends_stretch(events, times[n], out[n + 1], n):
             return n + 1, 0
     return out.shape[0] - 1, 0
@@ -233,7 +194,10 @@ def semi_implicit_euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_
                                       k1, k2, k3, k4, tmp, J, nfev)
         if st:
             return n, st
-        _normalize(out[n + 1], quats)
+        st = finish_step(out[n + 1], drive_table[n][2], nq, slots, quats, free_q, free_u,
+                         drive_q, drive_u, tree, ws)
+        if st:
+            return n, st
         if check_events and step_ends_stretch(events, times[n], out[n + 1], n):
             return n + 1, 0
     return out.shape[0] - 1, 0
@@ -253,7 +217,10 @@ def rk4_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, driv
                       drive_q, drive_u, tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
         if st:
             return n, st
-        _normalize(out[n + 1], quats)
+        st = finish_step(out[n + 1], drive_table[n][2], nq, slots, quats, free_q, free_u,
+                         drive_q, drive_u, tree, ws)
+        if st:
+            return n, st
         if check_events and step_ends_stretch(events, times[n], out[n + 1], n):
             return n + 1, 0
     return out.shape[0] - 1, 0
@@ -274,7 +241,10 @@ def implicit_midpoint_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u,
                            nfev)
         if st:
             return n, st
-        _normalize(out[n + 1], quats)
+        st = finish_step(out[n + 1], drive_table[n][2], nq, slots, quats, free_q, free_u,
+                         drive_q, drive_u, tree, ws)
+        if st:
+            return n, st
         if check_events and step_ends_stretch(events, times[n], out[n + 1], n):
             return n + 1, 0
     return out.shape[0] - 1, 0
@@ -317,7 +287,10 @@ def fixed_step_loop(scheme, h, y0, drive_table, nq, slots, quats, free_q, free_u
                                          nfev)
         if st:
             return n, st
-        _normalize(yn, quats)
+        st = finish_step(yn, drives[2], nq, slots, quats, free_q, free_u, drive_q, drive_u,
+                         tree, ws)
+        if st:
+            return n, st
     return out.shape[0] - 1, 0
 
 

@@ -1,0 +1,120 @@
+"""Closed loops from Python: the constraint residuals and Jacobian at a state, the
+constrained forward dynamics (``kernels.constrained``), the multipliers, the projection
+onto the constraint manifold, the rank of the constraints and the mobility.
+
+Conventions (``kernels.constraints``): ``phi(q) = 0`` holds on the mechanism, its rate is
+``psi = G u`` (plus the drives' part), and the accelerations satisfy ``G u' = gamma``.
+The multipliers ``lam`` are the reactions in the primitives' terms: a point's force, a
+perpendicularity's moment, as the parent exerts them on the child.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ModelError, SimulationError
+from ..kernels import constrained as kc
+from ..kernels.constrained import RANK_TOLERANCE
+
+
+def groups(model):
+    """The kernels' argument groups of a loop model's workspace."""
+    body = (model._mass, model._com, model._inertia, model._has_inertia, model.gravity)
+    state = (model._qfull, model._ufull, model._udfull)
+    jourdain = (model._M, model._f, model._L, model._ud)
+    return model._tree, body, state, model._loads_arrays, model._kin_out, jourdain
+
+
+def _evaluate(model, q, u, t):
+    """The kinematics and the constraint rows at ``(q, u, t)``: ``phi, psi, G, gamma``
+    left in the model's constraint workspace."""
+    q, u = model._fill(q, u, t)
+    tree, _, state, _, motion, _ = groups(model)
+    try:
+        kc.constraint_state(tree, state, motion, model._con, model._scratch)
+    except ZeroDivisionError:
+        raise model._division_by_zero(q, t) from None
+    return q, u
+
+
+def constraint_residuals(model, q, u=None, t=0.0):
+    """``(phi, psi)``: the position residuals of the loop constraints and their rates
+    (each row labelled by ``Model.constraint_rows``); zero on the mechanism."""
+    _require_loops(model)
+    _evaluate(model, q, np.zeros(model.nu) if u is None else u, t)
+    return model._con[2].copy(), model._con[3].copy()
+
+
+def constraint_jacobian(model, q, t=0.0):
+    """``G`` (constraint rows x free speeds): ``d phi / dt = G u`` (plus the drives')."""
+    _require_loops(model)
+    _evaluate(model, q, np.zeros(model.nu), t)
+    return model._con[4].copy()
+
+
+def constraint_rank(model, q, t=0.0):
+    """``(rank, smallest kept singular value / largest)`` of ``G`` at ``q``: rows above
+    ``RANK_TOLERANCE`` of the largest singular value count (docs/constraints.md)."""
+    G = model.constraint_jacobian(q, t)
+    if not G.size:
+        return 0, 1.0
+    sv = np.linalg.svd(G, compute_uv=False)
+    kept = sv[sv > RANK_TOLERANCE * sv[0]] if sv[0] > 0 else sv[:0]
+    return int(kept.size), float(kept[-1] / sv[0]) if kept.size else 1.0
+
+
+def mobility(model, q, t=0.0):
+    """Degrees of freedom the mechanism has at ``q``: free speeds minus the rank of the
+    constraints (Grübler's count is ``nu - rows``; redundant rows make the difference)."""
+    if model._con is None:
+        return model.nu
+    return model.nu - model.constraint_rank(q, t)[0]
+
+
+def constrained_accelerations(model, q, u, t=0.0):
+    """``u'`` of the closed mechanism, ``M u' = f + G^T lam``, ``G u' = gamma``; the
+    multipliers stay in the workspace (``multipliers``)."""
+    q, u = model._fill(q, u, t)
+    tree, body, state, loads, motion, jourdain = groups(model)
+    try:
+        status = kc.constrained_call(tree, body, state, loads, motion, jourdain, model._con,
+                                     model._scratch)
+    except ZeroDivisionError:
+        raise model._division_by_zero(q, t) from None
+    if status >= 0:
+        model._raise_singular(q, t, status)
+    if status == -2:
+        model._check_finite(q, u, t, model._ud, "the accelerations")
+    return model._ud.copy()
+
+
+def multipliers(model, q, u, t=0.0):
+    """``(u', lam)``: the accelerations and the minimum-norm multipliers."""
+    ud = constrained_accelerations(model, q, u, t)
+    return ud, model._con[6].copy()
+
+
+def project(model, q, u, t=0.0):
+    """``(q, u)`` moved onto the constraint manifold (Newton-Raphson on positions with
+    minimum-norm steps, then the velocities); raises ``SimulationError`` when the
+    positions do not converge (the mechanism cannot close there)."""
+    _require_loops(model)
+    q, u = model._fill(q, u, t)
+    y = np.concatenate([q, u])
+    tree, _, state, _, motion, _ = groups(model)
+    quats = np.array([s.start for s in model._quaternions], np.int64)
+    steps = kc.project_state_call(y, model.nq, model._slots, quats, model._free_q,
+                                  model._free_u, tree, state, motion, model._con,
+                                  model._scratch)
+    if steps < 0:
+        phi = model._con[2]
+        k = int(np.argmax(np.abs(phi)))
+        raise SimulationError(f"model {model.name!r}, t={t:.6g}: the loops cannot be closed "
+                              f"near this state (constraint {model.constraint_rows[k]} "
+                              f"residual {phi[k]:.3g} after "
+                              f"{kc.PROJECTION_ITERATIONS} Newton steps)")
+    return y[:model.nq].copy(), y[model.nq:].copy()
+
+
+def _require_loops(model):
+    if model._con is None:
+        raise ModelError(f"model {model.name!r} has no loop joints (no constraints)")

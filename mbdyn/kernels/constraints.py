@@ -1,0 +1,280 @@
+"""Constraint equations of closed loops: residuals ``Phi``, their rates, the Jacobian ``G``
+and the acceleration term ``gamma`` (step 3 of the textbook: "position vectors and
+constraint equations").
+
+Every loop joint is written as a few *primitive* constraints between a point or vector of
+a parent frame ``p`` and one of a child frame ``c`` (frame -1 is the ground):
+
+=========  ====  ==============================================================
+``POINT``  3     ``P_c - P_p = 0``: the two points coincide (world components)
+``PERP``   1     ``a . b = 0``: vector ``a`` of p stays perpendicular to ``b`` of c
+``SLIDE``  1     ``(P_c - P_p) . n = 0``: P_c stays in the plane through P_p normal to ``n`` of p
+``DIST``   1     ``(|P_c - P_p|^2 - L^2) / 2 = 0``: a massless rod of length L
+``COUPLE`` 1     ``q_a - ratio q_b - offset = 0``: two 1-DoF coordinates geared together
+=========  ====  ==============================================================
+
+Each residual's time derivative is exactly ``G u`` (plus the drives' part), with ``G``
+built from the frames' Jacobians (``kernels.kinematics``): the Newton-Raphson of the
+assembly and of the projection uses the true derivative.  ``gamma = -Phi''`` at ``u' = 0``
+(from the bias accelerations the kinematics leave in ``alpha``, ``a``), so that the
+accelerations satisfy ``G u' = gamma``.  All in world components.
+
+``con_int[k]``: kind, parent frame, child frame, then (``COUPLE``) the follower's and the
+leader's frame.  ``con_data[k]``: ``s_p`` (3, point in p's body axes), ``s_c`` (3),
+vector ``A`` (3, body axes of p), vector ``B`` (3, body axes of c), then the length or the
+ratio, then the offset.
+"""
+import numpy as np
+from numba import njit
+
+POINT, PERP, SLIDE, DIST, COUPLE = 0, 1, 2, 3, 4
+#: rows each primitive contributes
+ROWS = (3, 1, 1, 1, 1)
+#: floats of ``con_data`` per primitive
+DATA = 14
+
+
+@njit(cache=True, inline="always")
+def _cross(a, b, out):
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
+
+
+@njit(cache=True, inline="always")
+def _point(i, s, R, r, w, v, alpha, a, rho, P, vP, aP, t1, t2):
+    """World offset ``rho = R s``, position, velocity and bias acceleration of the point
+    ``s`` (body axes) of frame ``i`` (-1: the ground, at rest)."""
+    if i < 0:
+        for k in range(3):
+            rho[k] = s[k]
+            P[k] = s[k]
+            vP[k] = 0.0
+            aP[k] = 0.0
+        return
+    for k in range(3):
+        rho[k] = R[i, k, 0] * s[0] + R[i, k, 1] * s[1] + R[i, k, 2] * s[2]
+        P[k] = r[i, k] + rho[k]
+    _cross(w[i], rho, t1)
+    _cross(w[i], t1, t2)
+    for k in range(3):
+        vP[k] = v[i, k] + t1[k]
+    _cross(alpha[i], rho, t1)
+    for k in range(3):
+        aP[k] = a[i, k] + t1[k] + t2[k]
+
+
+@njit(cache=True, inline="always")
+def _vector(i, s, R, out):
+    if i < 0:
+        for k in range(3):
+            out[k] = s[k]
+        return
+    for k in range(3):
+        out[k] = R[i, k, 0] * s[0] + R[i, k, 1] * s[1] + R[i, k, 2] * s[2]
+
+
+@njit(cache=True, inline="always")
+def _add_point_row(G, row, i, rho, e, sign, JT, JR):
+    """``G[row] += sign * e^T J_P`` for the point at world offset ``rho`` of frame i:
+    ``J_P = JT - [rho]x JR`` (a point's velocity ``v + w x rho``)."""
+    if i < 0:
+        return
+    for col in range(G.shape[1]):
+        jr0, jr1, jr2 = JR[i, 0, col], JR[i, 1, col], JR[i, 2, col]
+        j0 = JT[i, 0, col] + jr1 * rho[2] - jr2 * rho[1]
+        j1 = JT[i, 1, col] + jr2 * rho[0] - jr0 * rho[2]
+        j2 = JT[i, 2, col] + jr0 * rho[1] - jr1 * rho[0]
+        G[row, col] += sign * (e[0] * j0 + e[1] * j1 + e[2] * j2)
+
+
+@njit(cache=True, inline="always")
+def _add_rotation_row(G, row, i, e, sign, JR):
+    """``G[row] += sign * e^T JR_i``."""
+    if i < 0:
+        return
+    for col in range(G.shape[1]):
+        G[row, col] += sign * (e[0] * JR[i, 0, col] + e[1] * JR[i, 1, col]
+                               + e[2] * JR[i, 2, col])
+
+
+def constraint_count(con_int):
+    """Rows of ``G`` the primitives ``con_int`` give."""
+    return int(sum(ROWS[k] for k in con_int[:, 0])) if len(con_int) else 0
+
+
+@njit(cache=True)
+def constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
+                    R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma):
+    """Fill the residuals ``phi`` (positions), ``psi`` (their rates), the Jacobian ``G``
+    (rows x free speeds) and ``gamma``, after a kinematic walk at the state (bias
+    accelerations in ``alpha``, ``a``: free speed rates zero, drives' rates given)."""
+    # long: one loop over the primitives, each kind's rows written where they are derived
+    # (a reader checks a kind's residual, rate, Jacobian and gamma side by side).
+    w0 = np.zeros(3)
+    rp, Pp, vp, ap = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
+    rc, Pc, vc, ac = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
+    va, vb, axb, t1, t2, t3, d, dv = (np.empty(3), np.empty(3), np.empty(3), np.empty(3),
+                                      np.empty(3), np.empty(3), np.empty(3), np.empty(3))
+    for k in range(G.shape[0]):
+        for col in range(G.shape[1]):
+            G[k, col] = 0.0
+    row = 0
+    for m in range(con_int.shape[0]):
+        kind, ip, ic = con_int[m, 0], con_int[m, 1], con_int[m, 2]
+        sp, sc = con_data[m, 0:3], con_data[m, 3:6]
+        A, B = con_data[m, 6:9], con_data[m, 9:12]
+        wp = w[ip] if ip >= 0 else w0
+        wc = w[ic] if ic >= 0 else w0
+        alp = alpha[ip] if ip >= 0 else w0
+        alc = alpha[ic] if ic >= 0 else w0
+        if kind == COUPLE:
+            fa, fb = con_int[m, 3], con_int[m, 4]
+            ratio, offset = con_data[m, 12], con_data[m, 13]
+            phi[row] = qfull[qoff[fa]] - ratio * qfull[qoff[fb]] - offset
+            psi[row] = ufull[uoff[fa]] - ratio * ufull[uoff[fb]]
+            g = 0.0
+            if ucol[fa] >= 0:
+                G[row, ucol[fa]] += 1.0
+            else:
+                g -= udfull[uoff[fa]]
+            if ucol[fb] >= 0:
+                G[row, ucol[fb]] -= ratio
+            else:
+                g += ratio * udfull[uoff[fb]]
+            gamma[row] = g
+            row += 1
+            continue
+        if kind == PERP:
+            _vector(ip, A, R, va)
+            _vector(ic, B, R, vb)
+            _cross(va, vb, axb)
+            phi[row] = va[0] * vb[0] + va[1] * vb[1] + va[2] * vb[2]
+            rate = 0.0
+            for k in range(3):
+                rate += axb[k] * (wc[k] - wp[k])
+            psi[row] = rate
+            _add_rotation_row(G, row, ic, axb, 1.0, JR)
+            _add_rotation_row(G, row, ip, axb, -1.0, JR)
+            # Phi'' at u' = 0: (a x b).(alpha_c - alpha_p) + (w_p x a) x b + a x (w_c x b)
+            _cross(wp, va, t1)
+            _cross(t1, vb, t2)
+            _cross(wc, vb, t1)
+            _cross(va, t1, t3)
+            acc = 0.0
+            for k in range(3):
+                acc += axb[k] * (alc[k] - alp[k]) + (t2[k] + t3[k]) * (wc[k] - wp[k])
+            gamma[row] = -acc
+            row += 1
+            continue
+        _point(ip, sp, R, r, w, v, alpha, a, rp, Pp, vp, ap, t1, t2)
+        _point(ic, sc, R, r, w, v, alpha, a, rc, Pc, vc, ac, t1, t2)
+        for k in range(3):
+            d[k] = Pc[k] - Pp[k]
+            dv[k] = vc[k] - vp[k]
+        if kind == POINT:
+            for k in range(3):
+                phi[row + k] = d[k]
+                psi[row + k] = dv[k]
+                gamma[row + k] = -(ac[k] - ap[k])
+                for j in range(3):
+                    t1[j] = 1.0 if j == k else 0.0
+                _add_point_row(G, row + k, ic, rc, t1, 1.0, JT, JR)
+                _add_point_row(G, row + k, ip, rp, t1, -1.0, JT, JR)
+            row += 3
+        elif kind == SLIDE:
+            _vector(ip, A, R, va)                          # n, fixed in p
+            _cross(wp, va, t1)                             # n'
+            phi[row] = d[0] * va[0] + d[1] * va[1] + d[2] * va[2]
+            psi[row] = (dv[0] * va[0] + dv[1] * va[1] + dv[2] * va[2]
+                        + d[0] * t1[0] + d[1] * t1[1] + d[2] * t1[2])
+            _add_point_row(G, row, ic, rc, va, 1.0, JT, JR)
+            _add_point_row(G, row, ip, rp, va, -1.0, JT, JR)
+            _cross(va, d, t2)                              # d . (w_p x n) = w_p . (n x d)
+            _add_rotation_row(G, row, ip, t2, 1.0, JR)
+            # Phi'' at u' = 0: d''.n + 2 d'.n' + d.(alpha_p x n + w_p x n')
+            _cross(alp, va, t2)
+            _cross(wp, t1, t3)
+            acc = 0.0
+            for k in range(3):
+                acc += (ac[k] - ap[k]) * va[k] + 2.0 * dv[k] * t1[k] + d[k] * (t2[k] + t3[k])
+            gamma[row] = -acc
+            row += 1
+        else:                                              # DIST
+            length = con_data[m, 12]
+            dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+            phi[row] = 0.5 * (dd - length * length)
+            psi[row] = d[0] * dv[0] + d[1] * dv[1] + d[2] * dv[2]
+            _add_point_row(G, row, ic, rc, d, 1.0, JT, JR)
+            _add_point_row(G, row, ip, rp, d, -1.0, JT, JR)
+            acc = 0.0
+            for k in range(3):
+                acc += dv[k] * dv[k] + d[k] * (ac[k] - ap[k])
+            gamma[row] = -acc
+            row += 1
+
+
+@njit(cache=True)
+def constraint_wrenches(con_int, con_data, R, r, lam, F, N, com, out):
+    """The loads the multipliers ``lam`` stand for: each primitive's force and moment on
+    its child (at the child's point) and the opposite on its parent, added to the
+    applied loads ``F``, ``N`` at the centres of mass (world).  ``out[m]``: the force and
+    moment on the child of primitive ``m`` at its child point (6), for the reactions.
+    ``COUPLE`` rows act on coordinates, not on bodies: no load here (their efforts are
+    returned by ``coupling_efforts``)."""
+    row = 0
+    rho, P, f, mo, t1, lever = (np.empty(3), np.empty(3), np.empty(3), np.empty(3),
+                                np.empty(3), np.empty(3))
+    va, vb, d, Pp = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
+    for m in range(con_int.shape[0]):
+        kind, ip, ic = con_int[m, 0], con_int[m, 1], con_int[m, 2]
+        for k in range(6):
+            out[m, k] = 0.0
+        if kind == COUPLE:
+            row += 1
+            continue
+        sp, sc = con_data[m, 0:3], con_data[m, 3:6]
+        for k in range(3):
+            f[k] = 0.0
+            mo[k] = 0.0
+        _vector(ic, sc, R, rho)
+        for k in range(3):
+            P[k] = (r[ic, k] if ic >= 0 else 0.0) + rho[k]
+        _vector(ip, sp, R, t1)
+        for k in range(3):
+            Pp[k] = (r[ip, k] if ip >= 0 else 0.0) + t1[k]
+            d[k] = P[k] - Pp[k]
+        if kind == POINT:
+            for k in range(3):
+                f[k] = lam[row + k]
+            row += 3
+        elif kind == PERP:
+            _vector(ip, con_data[m, 6:9], R, va)
+            _vector(ic, con_data[m, 9:12], R, vb)
+            _cross(va, vb, t1)
+            for k in range(3):
+                mo[k] = lam[row] * t1[k]
+            row += 1
+        elif kind == SLIDE:
+            _vector(ip, con_data[m, 6:9], R, va)
+            for k in range(3):
+                f[k] = lam[row] * va[k]
+            row += 1
+        else:
+            for k in range(3):
+                f[k] = lam[row] * d[k]
+            row += 1
+        for k in range(3):
+            out[m, k] = f[k]
+            out[m, 3 + k] = mo[k]
+        # on the child at P, on the parent the opposite at the same point P
+        for i, sign in ((ic, 1.0), (ip, -1.0)):
+            if i < 0:
+                continue
+            for k in range(3):
+                t1[k] = com[i, 0] * R[i, k, 0] + com[i, 1] * R[i, k, 1] + com[i, 2] * R[i, k, 2]
+                lever[k] = P[k] - r[i, k] - t1[k]          # centre of mass -> P
+            _cross(lever, f, t1)
+            for k in range(3):
+                F[i, k] += sign * f[k]
+                N[i, k] += sign * (mo[k] + t1[k])

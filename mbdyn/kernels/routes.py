@@ -1,0 +1,92 @@
+"""The routes the compiled integrators take, chosen when a loop is compiled by the layout
+of the model's workspace ``ws`` (``Model.loop_arguments``): the accelerations by
+Jourdain's ``M u' = f``, by the articulated bodies, or of a closed mechanism (``M u' = f +
+G^T lam``, ``G u' = gamma``), and what follows each step (unit quaternions; for a closed
+mechanism, the projection onto its constraints).  A run compiles only its own route.
+"""
+import numpy as np
+from numba import njit
+from numba.extending import overload
+
+from .constrained import constrained_accelerations, project_state
+from .evaluate import articulated_accelerations, jourdain_accelerations
+
+
+@njit(cache=True, inline="always")
+def _normalize(y, quats):
+    for s in range(quats.shape[0]):
+        i = quats[s]
+        n = np.sqrt(y[i] ** 2 + y[i + 1] ** 2 + y[i + 2] ** 2 + y[i + 3] ** 2)
+        for k in range(4):
+            y[i + k] /= n
+
+
+def accelerations(tree, body, loads, ws, ud):
+    """``ud = u'`` by the route the workspace ``ws`` is laid out for (see
+    ``_accelerations_route``); returns as ``evaluate.jourdain_accelerations``."""
+    raise NotImplementedError("compiled code only")
+
+
+@overload(accelerations, inline="always")
+def _accelerations_route(tree, body, loads, ws, ud):
+    """The formulation is chosen when the loop is compiled, by the workspace's type: 17
+    arrays (``M``, ``f``, ``L``, scratch last) for ``M u' = f``, 20 (the articulated-body
+    workspace, then the scratch; ``tree`` then lists each frame's own speed columns) for
+    the articulated-body algorithm.  A run compiles only its own route."""
+    if len(ws) == 18:
+        def constrained_route(tree, body, loads, ws, ud):
+            (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, F, N, M, f, L, scratch,
+             con) = ws
+            return constrained_accelerations(tree, body, (qfull, ufull, udfull), loads,
+                                             (R, r, w, v, alpha, a, JR, JT, F, N),
+                                             (M, f, L, ud), con, scratch)
+        return constrained_route
+    if len(ws) == 17:
+        def jourdain_route(tree, body, loads, ws, ud):
+            (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, F, N, M, f, L, scratch) = ws
+            return jourdain_accelerations(tree, body, (qfull, ufull, udfull), loads,
+                                          (R, r, w, v, alpha, a, JR, JT, F, N), (M, f, L, ud),
+                                          scratch)
+        return jourdain_route
+
+    def articulated_route(tree, body, loads, ws, ud):
+        (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, F, N, IA, pA, cb, U, Dl,
+         acc, scratch) = ws
+        mass, com, inertia, _, gravity = body
+        return articulated_accelerations(tree, (mass, com, inertia, gravity),
+                                         (qfull, ufull, udfull), loads,
+                                         (R, r, w, v, alpha, a, JR, JT, F, N),
+                                         (IA, pA, cb, U, Dl, acc), ud, scratch)
+    return articulated_route
+
+
+def finish_step(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_u, tree, ws):
+    """After a step: unit quaternions and, for a closed mechanism, the state projected
+    back onto the constraint manifold (``kernels.constrained.project_state``) with the
+    drives at the step's end ``drive_vals``.  Returns 0, or 5 when the projection failed."""
+    raise NotImplementedError("compiled code only")
+
+
+@overload(finish_step, inline="always")
+def _finish_step_route(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_u,
+                       tree, ws):
+    """Chosen by the workspace's layout, as ``accelerations``: a tree only normalises."""
+    if len(ws) == 18:
+        def project_route(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_u,
+                          tree, ws):
+            qfull, ufull, udfull = ws[0], ws[1], ws[2]
+            for d in range(drive_q.shape[0]):
+                qfull[drive_q[d]] = drive_vals[d, 0]
+                ufull[drive_u[d]] = drive_vals[d, 1]
+                udfull[drive_u[d]] = drive_vals[d, 2]
+            _normalize(y, quats)
+            steps = project_state(y, nq, slots, quats, free_q, free_u, tree,
+                                  (qfull, ufull, udfull), ws[3:13], ws[17], ws[16])
+            return 5 if steps < 0 else 0
+        return project_route
+
+    def normalize_route(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_u,
+                        tree, ws):
+        _normalize(y, quats)
+        return 0
+    return normalize_route
