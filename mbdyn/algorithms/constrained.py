@@ -112,7 +112,18 @@ def project(model, q, u, t=0.0):
                               f"near this state (constraint {model.constraint_rows[k]} "
                               f"residual {phi[k]:.3g} after "
                               f"{kc.PROJECTION_ITERATIONS} Newton steps)")
-    return y[:model.nq].copy(), y[model.nq:].copy()
+    q, u = y[:model.nq].copy(), y[model.nq:].copy()
+    _evaluate(model, q, u, t)
+    psi = model._con[3]
+    scale = 1.0 + float(np.abs(y[model.nq:]).max(initial=0.0))
+    if np.abs(psi).max(initial=0.0) > 1e-8 * scale:
+        k = int(np.argmax(np.abs(psi)))
+        raise SimulationError(f"model {model.name!r}, t={t:.6g}: the speeds cannot satisfy the "
+                              f"loop joint {model._row_joint[k]!r} (its constraint "
+                              f"{model.constraint_rows[k]} moves at {psi[k]:.3g} per second "
+                              "whatever the free speeds): the drives move it against its "
+                              "constraint -- drive fewer joints of the loop")
+    return q, u
 
 
 def _require_loops(model):

@@ -42,7 +42,8 @@ def loop_newton_euler(model, q, u, t=0.0):
     for k in range(m):                    # each multiplier's loads, through the same system
         F, N, unit = F0.copy(), N0.copy(), np.zeros(m)
         unit[k] = 1.0
-        kcon.constraint_wrenches(con_int, con_data, model._R, model._r, unit, F, N,
+        kcon.constraint_wrenches(con_int, con_data, model._parent, model._kind, model._axis,
+                             model._R, model._r, unit, F, N,
                                  model._com, prim)
         _system(model, F, N, A, b)
         K[:size, size + k] = -(b - b0)
@@ -61,7 +62,8 @@ def loop_newton_euler_reactions(model, q, u, t=0.0):
     con_int, con_data = model._con[0], model._con[1]
     prim = np.empty((con_int.shape[0], 6))
     n = model.n_frames
-    kcon.constraint_wrenches(con_int, con_data, model._R, model._r, lam, np.zeros((n, 3)),
+    kcon.constraint_wrenches(con_int, con_data, model._parent, model._kind, model._axis,
+                             model._R, model._r, lam, np.zeros((n, 3)),
                              np.zeros((n, 3)), model._com, prim)
     loops = {}
     for k, owner in enumerate(model._prim_joint):

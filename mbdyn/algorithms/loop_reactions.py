@@ -33,7 +33,8 @@ def _wrenches(model, lam, F, N, w, alpha, a):
     ``F``, ``N`` plus those of the multipliers ``lam``, with the frames' motion given."""
     con_int, con_data = model._con[0], model._con[1]
     prim = np.empty((con_int.shape[0], 6))
-    kcon.constraint_wrenches(con_int, con_data, model._R, model._r, lam, F, N, model._com,
+    kcon.constraint_wrenches(con_int, con_data, model._parent, model._kind, model._axis,
+                             model._R, model._r, lam, F, N, model._com,
                              prim)
     tree = np.empty((model.n_frames, 6))
     kd.joint_wrenches(model._mass, model._com, model._inertia, model._parent, model._R,

@@ -27,6 +27,8 @@ ratio, then the offset.
 import numpy as np
 from numba import njit
 
+from .joints import REVOLUTE
+
 POINT, PERP, SLIDE, DIST, COUPLE = 0, 1, 2, 3, 4
 #: rows each primitive contributes
 ROWS = (3, 1, 1, 1, 1)
@@ -75,9 +77,10 @@ def _vector(i, s, R, out):
 
 
 @njit(cache=True, inline="always")
-def _add_point_row(G, row, i, rho, e, sign, JT, JR):
+def _add_point_row(G, Gabs, row, i, rho, e, sign, JT, JR):
     """``G[row] += sign * e^T J_P`` for the point at world offset ``rho`` of frame i:
-    ``J_P = JT - [rho]x JR`` (a point's velocity ``v + w x rho``)."""
+    ``J_P = JT - [rho]x JR`` (a point's velocity ``v + w x rho``); ``Gabs`` sums the
+    terms' sizes (``_clean``)."""
     if i < 0:
         return
     for col in range(G.shape[1]):
@@ -85,17 +88,31 @@ def _add_point_row(G, row, i, rho, e, sign, JT, JR):
         j0 = JT[i, 0, col] + jr1 * rho[2] - jr2 * rho[1]
         j1 = JT[i, 1, col] + jr2 * rho[0] - jr0 * rho[2]
         j2 = JT[i, 2, col] + jr0 * rho[1] - jr1 * rho[0]
-        G[row, col] += sign * (e[0] * j0 + e[1] * j1 + e[2] * j2)
+        term = e[0] * j0 + e[1] * j1 + e[2] * j2
+        G[row, col] += sign * term
+        Gabs[row, col] += abs(term)
 
 
 @njit(cache=True, inline="always")
-def _add_rotation_row(G, row, i, e, sign, JR):
+def _add_rotation_row(G, Gabs, row, i, e, sign, JR):
     """``G[row] += sign * e^T JR_i``."""
     if i < 0:
         return
     for col in range(G.shape[1]):
-        G[row, col] += sign * (e[0] * JR[i, 0, col] + e[1] * JR[i, 1, col]
-                               + e[2] * JR[i, 2, col])
+        term = e[0] * JR[i, 0, col] + e[1] * JR[i, 1, col] + e[2] * JR[i, 2, col]
+        G[row, col] += sign * term
+        Gabs[row, col] += abs(term)
+
+
+@njit(cache=True, inline="always")
+def _clean(G, Gabs):
+    """Entries of ``G`` that are differences of equal terms (a loop joint between two
+    frames that a speed moves alike) are set to exactly zero: the round-off left there
+    would otherwise count as a constraint when no free speed moves the joint."""
+    for row in range(G.shape[0]):
+        for col in range(G.shape[1]):
+            if abs(G[row, col]) <= 64 * 2.220446049250313e-16 * Gabs[row, col]:
+                G[row, col] = 0.0
 
 
 def constraint_count(con_int):
@@ -116,6 +133,7 @@ def constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
     rc, Pc, vc, ac = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
     va, vb, axb, t1, t2, t3, d, dv = (np.empty(3), np.empty(3), np.empty(3), np.empty(3),
                                       np.empty(3), np.empty(3), np.empty(3), np.empty(3))
+    Gabs = np.zeros(G.shape)
     for k in range(G.shape[0]):
         for col in range(G.shape[1]):
             G[k, col] = 0.0
@@ -148,19 +166,21 @@ def constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
         if kind == PERP:
             _vector(ip, A, R, va)
             _vector(ic, B, R, vb)
-            _cross(va, vb, axb)
+            # Phi' = (w_p x a).b + a.(w_c x b) = e.(w_c - w_p) with e = b x a
+            _cross(vb, va, axb)
             phi[row] = va[0] * vb[0] + va[1] * vb[1] + va[2] * vb[2]
             rate = 0.0
             for k in range(3):
                 rate += axb[k] * (wc[k] - wp[k])
             psi[row] = rate
-            _add_rotation_row(G, row, ic, axb, 1.0, JR)
-            _add_rotation_row(G, row, ip, axb, -1.0, JR)
-            # Phi'' at u' = 0: (a x b).(alpha_c - alpha_p) + (w_p x a) x b + a x (w_c x b)
-            _cross(wp, va, t1)
-            _cross(t1, vb, t2)
+            _add_rotation_row(G, Gabs, row, ic, axb, 1.0, JR)
+            _add_rotation_row(G, Gabs, row, ip, axb, -1.0, JR)
+            # Phi'' at u' = 0: e.(alpha_c - alpha_p) + e'.(w_c - w_p), with
+            # e' = (w_c x b) x a + b x (w_p x a)
             _cross(wc, vb, t1)
-            _cross(va, t1, t3)
+            _cross(t1, va, t2)
+            _cross(wp, va, t1)
+            _cross(vb, t1, t3)
             acc = 0.0
             for k in range(3):
                 acc += axb[k] * (alc[k] - alp[k]) + (t2[k] + t3[k]) * (wc[k] - wp[k])
@@ -179,8 +199,8 @@ def constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
                 gamma[row + k] = -(ac[k] - ap[k])
                 for j in range(3):
                     t1[j] = 1.0 if j == k else 0.0
-                _add_point_row(G, row + k, ic, rc, t1, 1.0, JT, JR)
-                _add_point_row(G, row + k, ip, rp, t1, -1.0, JT, JR)
+                _add_point_row(G, Gabs, row + k, ic, rc, t1, 1.0, JT, JR)
+                _add_point_row(G, Gabs, row + k, ip, rp, t1, -1.0, JT, JR)
             row += 3
         elif kind == SLIDE:
             _vector(ip, A, R, va)                          # n, fixed in p
@@ -188,10 +208,10 @@ def constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
             phi[row] = d[0] * va[0] + d[1] * va[1] + d[2] * va[2]
             psi[row] = (dv[0] * va[0] + dv[1] * va[1] + dv[2] * va[2]
                         + d[0] * t1[0] + d[1] * t1[1] + d[2] * t1[2])
-            _add_point_row(G, row, ic, rc, va, 1.0, JT, JR)
-            _add_point_row(G, row, ip, rp, va, -1.0, JT, JR)
+            _add_point_row(G, Gabs, row, ic, rc, va, 1.0, JT, JR)
+            _add_point_row(G, Gabs, row, ip, rp, va, -1.0, JT, JR)
             _cross(va, d, t2)                              # d . (w_p x n) = w_p . (n x d)
-            _add_rotation_row(G, row, ip, t2, 1.0, JR)
+            _add_rotation_row(G, Gabs, row, ip, t2, 1.0, JR)
             # Phi'' at u' = 0: d''.n + 2 d'.n' + d.(alpha_p x n + w_p x n')
             _cross(alp, va, t2)
             _cross(wp, t1, t3)
@@ -205,23 +225,41 @@ def constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
             dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
             phi[row] = 0.5 * (dd - length * length)
             psi[row] = d[0] * dv[0] + d[1] * dv[1] + d[2] * dv[2]
-            _add_point_row(G, row, ic, rc, d, 1.0, JT, JR)
-            _add_point_row(G, row, ip, rp, d, -1.0, JT, JR)
+            _add_point_row(G, Gabs, row, ic, rc, d, 1.0, JT, JR)
+            _add_point_row(G, Gabs, row, ip, rp, d, -1.0, JT, JR)
             acc = 0.0
             for k in range(3):
                 acc += dv[k] * dv[k] + d[k] * (ac[k] - ap[k])
             gamma[row] = -acc
             row += 1
+    _clean(G, Gabs)
+
+
+@njit(cache=True, inline="always")
+def _apply(ic, ip, P, f, mo, R, r, com, F, N, t1, lever):
+    """Force ``f`` at the world point ``P`` and moment ``mo`` on frame ``ic``, the opposite
+    on frame ``ip`` (-1: the ground), reduced to their centres of mass."""
+    for i, sign in ((ic, 1.0), (ip, -1.0)):
+        if i < 0:
+            continue
+        for k in range(3):
+            t1[k] = com[i, 0] * R[i, k, 0] + com[i, 1] * R[i, k, 1] + com[i, 2] * R[i, k, 2]
+            lever[k] = P[k] - r[i, k] - t1[k]          # centre of mass -> P
+        _cross(lever, f, t1)
+        for k in range(3):
+            F[i, k] += sign * f[k]
+            N[i, k] += sign * (mo[k] + t1[k])
 
 
 @njit(cache=True)
-def constraint_wrenches(con_int, con_data, R, r, lam, F, N, com, out):
+def constraint_wrenches(con_int, con_data, parent, kind_of, axis, R, r, lam, F, N, com, out):
     """The loads the multipliers ``lam`` stand for: each primitive's force and moment on
     its child (at the child's point) and the opposite on its parent, added to the
     applied loads ``F``, ``N`` at the centres of mass (world).  ``out[m]``: the force and
     moment on the child of primitive ``m`` at its child point (6), for the reactions.
-    ``COUPLE`` rows act on coordinates, not on bodies: no load here (their efforts are
-    returned by ``coupling_efforts``)."""
+    A ``COUPLE`` row's multiplier is a torque (force) along the follower joint's axis
+    between its parent and child, and ``-ratio`` times it along the leader's -- the
+    gear mesh's efforts (``parent``, ``kind_of``, ``axis``: the tree's joints)."""
     row = 0
     rho, P, f, mo, t1, lever = (np.empty(3), np.empty(3), np.empty(3), np.empty(3),
                                 np.empty(3), np.empty(3))
@@ -231,6 +269,17 @@ def constraint_wrenches(con_int, con_data, R, r, lam, F, N, com, out):
         for k in range(6):
             out[m, k] = 0.0
         if kind == COUPLE:
+            for j, scale in ((con_int[m, 3], 1.0), (con_int[m, 4], -con_data[m, 12])):
+                _vector(j, axis[j], R, va)                 # the joint's axis, world
+                for k in range(3):
+                    P[k] = r[j, k]
+                    f[k] = 0.0
+                    mo[k] = 0.0
+                    if kind_of[j] == REVOLUTE:
+                        mo[k] = scale * lam[row] * va[k]
+                    else:
+                        f[k] = scale * lam[row] * va[k]
+                _apply(j, parent[j], P, f, mo, R, r, com, F, N, t1, lever)
             row += 1
             continue
         sp, sc = con_data[m, 0:3], con_data[m, 3:6]
@@ -251,7 +300,7 @@ def constraint_wrenches(con_int, con_data, R, r, lam, F, N, com, out):
         elif kind == PERP:
             _vector(ip, con_data[m, 6:9], R, va)
             _vector(ic, con_data[m, 9:12], R, vb)
-            _cross(va, vb, t1)
+            _cross(vb, va, t1)                  # the moment's axis: b x a (see PERP's rows)
             for k in range(3):
                 mo[k] = lam[row] * t1[k]
             row += 1
@@ -267,14 +316,4 @@ def constraint_wrenches(con_int, con_data, R, r, lam, F, N, com, out):
         for k in range(3):
             out[m, k] = f[k]
             out[m, 3 + k] = mo[k]
-        # on the child at P, on the parent the opposite at the same point P
-        for i, sign in ((ic, 1.0), (ip, -1.0)):
-            if i < 0:
-                continue
-            for k in range(3):
-                t1[k] = com[i, 0] * R[i, k, 0] + com[i, 1] * R[i, k, 1] + com[i, 2] * R[i, k, 2]
-                lever[k] = P[k] - r[i, k] - t1[k]          # centre of mass -> P
-            _cross(lever, f, t1)
-            for k in range(3):
-                F[i, k] += sign * f[k]
-                N[i, k] += sign * (mo[k] + t1[k])
+        _apply(ic, ip, P, f, mo, R, r, com, F, N, t1, lever)   # the parent at the same P
