@@ -36,7 +36,15 @@ def closed_initial_state(model, q, u, t0):
             f"{bad[k]:.3g}); assemble it first: q0, u0 = model.assemble(initial={{...held "
             "values...}}, initial_speeds={...}, guess={...}) (model files do this from "
             "[initial], [initial_speeds] and [guess])")
-    return model.project(q, u, t0)
+    q, u = model.project(q, u, t0)
+    info = model._con[7]
+    info[2] = info[3] = model.constraint_rank(q, t0)[0]   # the run holds this rank
+    return q, u
+
+
+def release_rank(model):
+    """After a run: evaluations decide the rank by the tolerance again."""
+    model._con[7][2] = -1.0
 
 
 def loop_report(model, result):

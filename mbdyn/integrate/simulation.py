@@ -21,7 +21,7 @@ from ..compiled.force_packing import warn_outside_tables
 from ..errors import ModelError, ModelWarning, SimulationError
 from . import compiled_adaptive, fixed_step, scipy_solvers
 from .budget import check_fixed_step, make_budget
-from .closed_loops import closed_initial_state, loop_report
+from .closed_loops import closed_initial_state, loop_report, release_rank
 from .events import Event, as_event, check_conditions
 from .monitor import Monitor, conditioning
 from .plan import Plan, RightHandSide
@@ -109,7 +109,11 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
                           else start + budget["max_wall_time"])
     plan = Plan(rhs, integrator, t0, t_end, y0, events, t_eval, progress, monitor, budget,
                 rtol, atol, max_step, dt if integrator not in ADAPTIVE else None)
-    outcome = _integrate(plan, compiled_loop)
+    try:
+        outcome = _integrate(plan, compiled_loop)
+    finally:
+        if model.has_loops:
+            release_rank(model)
     stats = {"integrator": integrator, "method": method, "rtol": rtol, "atol": atol, "dt": dt,
              "rhs_evaluations": rhs.evaluations, "wall_time_s": _time.perf_counter() - start}
     result = _result(model, outcome, stats, pre_stats, monitor)
@@ -185,6 +189,12 @@ def _check_t_eval(t_eval, t0, t_end):
         raise ModelError(f"t_eval has times outside t0..t_end = {t0:g}..{t_end:g} (e.g. "
                          f"{outside[0]:g}); they would be dropped -- raise t_end or remove "
                          "them")
+    # a time past t_end by round-off (0.03 / 1e-4 steps of 1e-4 end at 0.030000000000000002)
+    # is t_end: the integrator stops there and would never reach it
+    t_eval = np.clip(t_eval, t0, t_end)
+    if np.any(np.diff(t_eval) <= 0):
+        raise ModelError("t_eval has two times that are the same within round-off at t0 or "
+                         "t_end; remove one")
     return t_eval
 
 

@@ -60,8 +60,13 @@ def constrained_solve(M, L, ud, G, gamma, lam, info):
     rank = 0
     smallest = 1.0
     c = np.zeros(sv.shape[0])
+    keep = info[2]               # during a run: the rank at the last projected state
     for k in range(sv.shape[0]):
-        if sv[k] > RANK_TOLERANCE * top and top > 0.0:
+        if keep >= 0:
+            use = k < keep and sv[k] > 1e-14 * top
+        else:
+            use = sv[k] > RANK_TOLERANCE * top
+        if use and top > 0.0:
             rank += 1
             smallest = sv[k] / top
             acc = 0.0
@@ -205,7 +210,25 @@ def project_state(y, nq, slots, quats, free_q, free_u, tree, state, motion, con,
         du = np.linalg.lstsq(G, psi, RANK_TOLERANCE)[0]
         for k in range(nu):
             y[nq + k] -= du[k]
+    if info[2] >= 0:                 # a run: the rank here, for the next step's stages
+        info[2] = rank_of(G)
+        info[3] = min(info[3], info[2])
     return steps
+
+
+@njit(cache=True)
+def rank_of(G):
+    """Singular values of ``G`` above ``RANK_TOLERANCE`` of the largest."""
+    if G.shape[0] == 0 or G.shape[1] == 0:
+        return 0
+    sv = np.linalg.svd(G)[1]
+    if sv[0] <= 0.0:
+        return 0
+    rank = 0
+    for k in range(sv.shape[0]):
+        if sv[k] > RANK_TOLERANCE * sv[0]:
+            rank += 1
+    return rank
 
 
 @njit(cache=True)
