@@ -319,3 +319,18 @@ reactions = true
     with pytest.raises(mb.ModelError, match="guess"):
         mb.load_model(str(bad))
 
+
+
+def test_parallelogram_passing_its_singular_configuration_is_reported():
+    """A parallelogram four-bar (a = c, b = d) turning through th2 = pi, where its links
+    lie in line and its mobility jumps: the run names the passage and its time, and goes
+    on along the parallelogram branch (the rocker follows the crank)."""
+    m = four_bar(a=0.1, b=0.3, c=0.1, d=0.3, g=0.0)
+    q, u = m.assemble({"th2": 2.0}, {"th2": 3.0}, guess={"th3": -2.0, "th4": 2.0})
+    with pytest.warns(mb.SingularityWarning, match="singular configuration near t="):
+        res = mb.simulate(m, 0.8, q, u, t_eval=np.linspace(0, 0.8, 81))
+    passage = res.stats["singular_configuration"]["t"]
+    th2 = res.q[:, m.coordinate_index("th2")]
+    t_pi = np.interp(np.pi, th2, res.t)
+    assert abs(passage - t_pi) <= 0.011       # the nearest sample to the passage
+    np.testing.assert_allclose(res.q[:, m.coordinate_index("th4")], th2, atol=1e-8)

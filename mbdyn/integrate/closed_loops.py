@@ -16,8 +16,9 @@ QUIET_PROJECTION = 1e-8
 #: a run whose constraint drift exceeds this gets a warning (metres or dimensionless)
 DRIFT_WARNING = 1e-8
 #: the smallest kept singular value of the constraint Jacobian over the largest below
-#: which a configuration is reported as near-singular
-NEAR_SINGULAR = 1e-4
+#: which a configuration is reported as near-singular (a planar four-bar 0.01 rad from
+#: its links in line)
+NEAR_SINGULAR = 1e-2
 
 
 def closed_initial_state(model, q, u, t0):
@@ -38,7 +39,9 @@ def closed_initial_state(model, q, u, t0):
             "[initial], [initial_speeds] and [guess])")
     q, u = model.project(q, u, t0)
     info = model._con[7]
-    info[2] = info[3] = model.constraint_rank(q, t0)[0]   # the run holds this rank
+    rank, ratio = model.constraint_rank(q, t0)
+    info[2] = info[3] = rank                  # the run holds this rank (kernels.constrained)
+    info[4] = ratio
     return q, u
 
 
@@ -75,20 +78,29 @@ def loop_report(model, result):
     stats["constraint_rank"] = rank0
     stats["mobility"] = model.nu - rank0
     low = min(range(len(ranks)), key=lambda k: (ranks[k][0], ranks[k][1]))
-    stats["constraint_conditioning_min"] = ranks[low][1]
-    if ranks[low][0] < rank0:
-        stats["singular_configuration"] = {"t": float(result.t[low]), "rank": ranks[low][0]}
+    # the steps' own lowest rank and conditioning (kernels.constrained keeps them): a
+    # passage between two samples is seen there; its time is the nearest sample's
+    info = model._con[7]
+    rank_low = min(ranks[low][0], int(info[3]) if np.isfinite(info[3]) else rank0)
+    ratio_low = min(ranks[low][1], float(info[4]))
+    stats["constraint_conditioning_min"] = ratio_low
+    where = f"near t={result.t[low]:.6g}"
+    if rank_low < rank0:
+        stats["singular_configuration"] = {"t": float(result.t[low]), "rank": rank_low}
         warnings.warn(
-            f"model {model.name!r}: the loop constraints lose rank at t={result.t[low]:.6g} "
-            f"(rank {ranks[low][0]} instead of {rank0}): a singular configuration, where the "
-            "mechanism's mobility jumps (e.g. a four-bar with its links in line).  The motion "
-            "went on along the branch the inertia chose; check it, or avoid the "
-            "configuration", SingularityWarning, stacklevel=3)
-    elif ranks[low][1] < NEAR_SINGULAR:
+            f"model {model.name!r}: the loop constraints lose rank {where} (rank {rank_low} "
+            f"instead of {rank0}): a singular configuration, where the mechanism's mobility "
+            "jumps (e.g. a four-bar with its links in line).  The motion went on along the "
+            "branch the inertia chose; check it, or avoid the configuration",
+            SingularityWarning, stacklevel=3)
+    elif ratio_low < NEAR_SINGULAR:
+        stats["singular_configuration"] = {"t": float(result.t[low]), "rank": rank_low,
+                                           "conditioning": ratio_low}
         warnings.warn(
-            f"model {model.name!r}: near a singular configuration at t={result.t[low]:.6g} "
-            f"(the constraints' weakest direction is {ranks[low][1]:.2g} of the strongest): "
-            "reactions grow large and the assembly branch may switch; check the motion",
+            f"model {model.name!r}: the motion passes close to a singular configuration "
+            f"{where} (the constraints' weakest direction fell to {ratio_low:.2g} of the "
+            "strongest): the reactions grow large there and the assembly branch may switch "
+            "(a four-bar with its links nearly in line); check the motion",
             SingularityWarning, stacklevel=3)
     if drift > DRIFT_WARNING:
         warnings.warn(f"model {model.name!r}: the loop constraints drifted by {drift:.3g} over "

@@ -28,6 +28,12 @@ from .kinematics import walk
 #: singular values of ``Y = L^-1 G^T`` below this fraction of the largest are taken as
 #: zero (redundant constraints, or a singular configuration)
 RANK_TOLERANCE = 1e-9
+#: during a run, a singular value of ``Y`` below this fraction of the largest is dropped
+#: although the mechanism's rank counts it: the configuration is (nearly) singular, where
+#: the stages of a step, off the manifold, would divide a residual by its square; the
+#: motion then follows its inertia along that direction for the step, and the projection
+#: puts it back on the constraints (a smooth passage, docs/constraints.md)
+PASSAGE_TOLERANCE = 1e-6
 #: the projection stops when every position residual is below this (metres for points,
 #: dimensionless for directions)
 PROJECTION_TOLERANCE = 1e-13
@@ -63,7 +69,7 @@ def constrained_solve(M, L, ud, G, gamma, lam, info):
     keep = info[2]               # during a run: the rank at the last projected state
     for k in range(sv.shape[0]):
         if keep >= 0:
-            use = k < keep and sv[k] > 1e-14 * top
+            use = k < keep and sv[k] > PASSAGE_TOLERANCE * top
         else:
             use = sv[k] > RANK_TOLERANCE * top
         if use and top > 0.0:
@@ -211,24 +217,27 @@ def project_state(y, nq, slots, quats, free_q, free_u, tree, state, motion, con,
         for k in range(nu):
             y[nq + k] -= du[k]
     if info[2] >= 0:                 # a run: the rank here, for the next step's stages
-        info[2] = rank_of(G)
-        info[3] = min(info[3], info[2])
+        rank, ratio = rank_of(G)
+        info[2] = rank
+        info[3] = min(info[3], rank)
+        info[4] = min(info[4], ratio)
     return steps
 
 
 @njit(cache=True)
 def rank_of(G):
-    """Singular values of ``G`` above ``RANK_TOLERANCE`` of the largest."""
+    """``(rank, conditioning)``: the singular values of ``G`` above ``RANK_TOLERANCE`` of
+    the largest, and the smallest of them over the largest."""
     if G.shape[0] == 0 or G.shape[1] == 0:
-        return 0
+        return 0, 1.0
     sv = np.linalg.svd(G)[1]
     if sv[0] <= 0.0:
-        return 0
+        return 0, 1.0
     rank = 0
     for k in range(sv.shape[0]):
         if sv[k] > RANK_TOLERANCE * sv[0]:
             rank += 1
-    return rank
+    return rank, sv[rank - 1] / sv[0]
 
 
 @njit(cache=True)
