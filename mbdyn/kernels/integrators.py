@@ -44,25 +44,26 @@ def accelerations(tree, body, loads, ws, ud):
 
 @overload(accelerations, inline="always")
 def _accelerations_route(tree, body, loads, ws, ud):
-    """The formulation is chosen when the loop is compiled, by the workspace's type: 17
-    arrays (``M``, ``f``, ``L``, scratch last) for ``M u' = f``, 20 (the articulated-body
-    workspace, then the scratch; ``tree`` then lists each frame's own speed columns) for
-    the articulated-body algorithm.  A run compiles only its own route."""
-    if len(ws) == 17:
+    """The formulation is chosen when the loop is compiled, by the workspace's type: 18
+    arrays (``M``, ``f``, ``L``, scratch last) for ``M u' = f``, 21 (the articulated-body
+    workspace, then the scratch; ``tree`` then has empty ancestor lists) for the
+    articulated-body algorithm.  A run compiles only its own route."""
+    if len(ws) == 18:
         def jourdain_route(tree, body, loads, ws, ud):
-            (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, F, N, M, f, L, scratch) = ws
+            (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S, F, N, M, f, L,
+             scratch) = ws
             return jourdain_accelerations(tree, body, (qfull, ufull, udfull), loads,
-                                          (R, r, w, v, alpha, a, JR, JT, F, N), (M, f, L, ud),
-                                          scratch)
+                                          (R, r, w, v, alpha, a, JR, JT, S, F, N),
+                                          (M, f, L, ud), scratch)
         return jourdain_route
 
     def articulated_route(tree, body, loads, ws, ud):
-        (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, F, N, IA, pA, cb, U, Dl,
+        (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S, F, N, IA, pA, cb, U, Dl,
          acc, scratch) = ws
         mass, com, inertia, _, gravity = body
         return articulated_accelerations(tree, (mass, com, inertia, gravity),
                                          (qfull, ufull, udfull), loads,
-                                         (R, r, w, v, alpha, a, JR, JT, F, N),
+                                         (R, r, w, v, alpha, a, JR, JT, S, F, N),
                                          (IA, pA, cb, U, Dl, acc), ud, scratch)
     return articulated_route
 
