@@ -275,6 +275,7 @@ def subkernel_cases(model, q, u, ke):
         def solve(A, b):
             return np.linalg.solve(A, b)
         _SOLVE = solve
+    m._dense_system()                   # (allocates the full Jacobians and M too)
     m._fill(q, u, 0.0)
     ud = np.empty(m.nu)
     kin = (*m._tree, m._mass, m._com, m.gravity, m._qfull, m._ufull, m._udfull,

@@ -40,8 +40,13 @@ def forward_dynamics(model, q, u, t=0.0, method="jourdain"):
         q, u = model._state(q, u)
         if model._python_inputs:
             model._fill_inputs(q, u, t)
-        kernel = (kp.jourdain_accelerations_packed if method == "jourdain"
-                  else kp.articulated_accelerations_packed)
+        if method == "jourdain":
+            kernel = model._jourdain_kernel
+            if kernel is None:                    # its arrays not yet allocated
+                model._full_workspace()
+                kernel = model._jourdain_kernel
+        else:
+            kernel = kp.articulated_accelerations_packed
         try:
             pivot = kernel(*model._packed, q, u)
         except ZeroDivisionError:
@@ -90,7 +95,10 @@ def state_derivative(model, t, y, method="jourdain"):
         ydot[:model.nq] = model.coordinate_rates(q, u)
         return ydot
     if method == "jourdain":
-        kernel = kp.state_derivative_packed
+        kernel = model._jourdain_rates
+        if kernel is None:
+            model._full_workspace()
+            kernel = model._jourdain_rates
     elif method == "articulated":
         kernel = kp.state_derivative_articulated_packed
     else:

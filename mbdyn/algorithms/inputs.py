@@ -97,7 +97,7 @@ def fill_laws(model, q, u, t):
             if not kinematics_done:
                 from ..kernels.kinematics import forward_kinematics
                 forward_kinematics(*model._tree, model._qfull, model._ufull, model._udfull,
-                                   *model._kin_out[:8])
+                                   *model._kin_out[:9])
                 kinematics_done = True
             ends = []
             for frame, point in zip(el.frames, (p["point_a"], p["point_b"])):

@@ -14,6 +14,7 @@ from ..kernels import packed as kp
 
 
 def jourdain_terms(model, q, u, t):
+    model._full_workspace()
     q, u = model._kinematics_kernel(q, u, t)
     model._drop_velocity_products()
     kd.jourdain_terms(model._mass, model._com, model._inertia, model._has_inertia, model._R,
@@ -57,6 +58,7 @@ def jourdain_packed(model, q, u, t):
     (``kernels.packed.jourdain_accelerations_packed``, which solves for ``u'`` too: a
     small part of its cost, and no extra compiled entry point)."""
     q, u = model._state(q, u)
+    model._full_workspace()
     if model._python_inputs:
         model._fill_inputs(q, u, t)
     try:

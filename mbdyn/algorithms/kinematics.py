@@ -68,7 +68,7 @@ def drop_velocity_products(model):
     """With the gyroscopic effect off: bias accelerations without velocity products."""
     if not model.gyroscopic:
         ke.drop_velocity_products(*model._tree, model._qfull, model._ufull, model._udfull,
-                                  *model._kin_out[:8], model._scratch)
+                                  *model._kin_out[:9], model._scratch)
 
 
 def kinematics(model, q, u=None, ud=None, t=0.0):
@@ -90,6 +90,7 @@ def kinematics(model, q, u=None, ud=None, t=0.0):
 def jacobian_rotation(model, q, frame, t=0.0):
     """``dw/du`` of a frame (3 x nu, world components)."""
     i = model.frame_index(frame)
+    model._full_workspace()
     model._kinematics_kernel(q, np.zeros(model.nu), t)
     return model._JR[i].copy()
 
@@ -101,6 +102,7 @@ def jacobian_translation(model, q, frame, point=None, t=0.0):
     mass of a body (the origin of a massless frame).
     """
     i = model.frame_index(frame)
+    model._full_workspace()
     model._kinematics_kernel(q, np.zeros(model.nu), t)
     p = model._com[i] if point is None else np.asarray(point, dtype=float)
     out = np.empty((3, model.nu))

@@ -49,9 +49,9 @@ def solve(model, q, u, t, dense=False):
     try:
         # the steps of newton_euler_solution with kernels a run compiles anyway, and
         # the LU solve from Python: no fused entry point of its own to compile
+        A, b = model._dense_system()          # (and the full Jacobians, before the walk)
         model._kinematics_kernel(q, u, t)
         model._drop_velocity_products()
-        A, b = model._dense_system()
         kd.newton_euler_system(model._mass, model._com, model._inertia, model._parent,
                                model._R, model._r, model._w, model._alpha, model._a,
                                model._JR, model._JT, model._anc_ptr, model._anc_idx,

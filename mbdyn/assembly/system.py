@@ -73,6 +73,7 @@ class System:
         self.graph.add_node(GROUND, body=make_body(GROUND))
         self._joints = {}
         self._loop_joints = {}          # name -> LoopJoint (assembly.loops)
+        self._state_names = set()     # the joints' coordinates and speeds
         self._loads = {}
         self._forces = {}
 
@@ -187,12 +188,12 @@ class System:
         joint = make_joint(name, kind, parent, child, axis=axis, position=position,
                            orientation=orientation, sequence=sequence, coordinates=coordinates,
                            speeds=speeds, drive=drive, parameters=self.parameters)
-        names_in_use = {c for j in self._joints.values() for c in j.coordinates + j.speeds}
-        clash = names_in_use.intersection(joint.coordinates + joint.speeds)
+        clash = self._state_names.intersection(joint.coordinates + joint.speeds)
         if clash:
             raise ModelError(f"{element}: coordinate/speed names {sorted(clash)} are already "
                              "used by another joint; pass coordinates=(...) to rename them")
         self._joints[name] = joint
+        self._state_names.update(joint.coordinates + joint.speeds)
         self.graph.add_edge(parent, child, joint=joint)
         return name
 

@@ -4,16 +4,20 @@ order, and the workspace every evaluation writes into.
 Each function lays out one part and sets it on the ``Model`` (its private ``_``
 attributes, which the algorithms and kernels read): the tree, the coordinates, the bodies,
 the reaction directions, the loads, the workspace.  ``Model.__init__`` calls them in this
-order; ``pack`` then moves the arrays the fused kernels read into two flat buffers.
+order; ``pack`` then moves the arrays the fused kernels read into two flat buffers.  What
+only the Jourdain and dense Newton-Euler routes read (the full Jacobians, ``M``, the
+ancestor-column lists: O(n nu) and O(nu^2)) is laid out by ``full_workspace`` on the first
+use of such a route.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from ..kernels import evaluate as ke
+from ..kernels import joints as kj
+from ..kernels import packed as kp
 from ..kernels.constraints import constraint_count
 from .constraint_packing import pack_constraints
-from ..kernels import packed as kp
 
 
 def tree(model, joints):
@@ -81,21 +85,25 @@ def coordinates(model, joints):
             ui += j.nu
 
 
-def columns(model, joints):
-    """The columns of ``u`` each frame's motion depends on: its own joint's and its
-    ancestors' (the Jacobians' sparsity), and its own joint's only (all the articulated
-    body route reads), as compressed rows ``(ptr, idx)``."""
-    ucol, parent = model._ucol, model._parent
-    own = [list(range(ucol[i], ucol[i] + j.nu)) if ucol[i] >= 0 else []
-           for i, j in enumerate(joints)]
-    cols = []
-    for i in range(len(joints)):
-        inherited = cols[parent[i]] if parent[i] >= 0 else []
-        cols.append(sorted(inherited + own[i]))
-    model._anc_ptr = np.cumsum([0] + [len(c) for c in cols]).astype(np.int64)
-    model._anc_idx = np.array([c for cs in cols for c in cs], np.int64)
-    model._own_ptr = np.cumsum([0] + [len(c) for c in own]).astype(np.int64)
-    model._own_idx = np.array([c for cs in own for c in cs], np.int64)
+def columns(model):
+    """The columns of ``u`` each frame's motion depends on, its own joint's and its
+    ancestors' (the Jacobians' sparsity), as compressed rows ``(ptr, idx)``: O(n depth)
+    entries (50 million for a 10,000-body chain), built by ``full_workspace`` only."""
+    ucol, parent, kind = model._ucol, model._parent, model._kind
+    counts = np.zeros(model.n_frames, np.int64)
+    for i in range(model.n_frames):
+        own = kj.NU[kind[i]] if ucol[i] >= 0 else 0
+        counts[i] = own + (counts[parent[i]] if parent[i] >= 0 else 0)
+    ptr = np.zeros(model.n_frames + 1, np.int64)
+    np.cumsum(counts, out=ptr[1:])
+    idx = np.empty(ptr[-1], np.int64)
+    for i in range(model.n_frames):
+        at, p = ptr[i], parent[i]
+        if p >= 0:                      # the parent's columns come first: all smaller
+            idx[at:at + counts[p]] = idx[ptr[p]:ptr[p + 1]]
+            at += counts[p]
+        idx[at:ptr[i + 1]] = np.arange(ucol[i], ucol[i] + ptr[i + 1] - at)
+    return ptr, idx
 
 
 def bodies(model, records):
@@ -182,12 +190,14 @@ def loads(model, records):
 
 
 def workspace(model, joints):
-    """The arrays every evaluation writes into: joint-space state, frame motion, Jacobians,
-    applied loads, ``M``, ``f`` and their factor, the articulated inertias, the reaction
+    """The arrays every evaluation writes into: joint-space state, frame motion, the
+    joints' motion subspaces, applied loads, ``f``, the articulated inertias, the reaction
     unknowns, and one scratch array for the kernels' temporaries
-    (``kernels.evaluate.scratch_size``).  The dense Newton-Euler system (6n x 6n) is not
-    here: only its route needs it, and it is allocated on its first use
-    (``Model._dense_system``): a 5,000-body model would otherwise hold 7 GB for it."""
+    (``kernels.evaluate.scratch_size``): O(n + nu) floats.  The full Jacobians, ``M`` and
+    its factor are empty here, allocated with the ancestor lists on the first use of a
+    route that reads them (``full_workspace``), and the dense Newton-Euler system
+    (6n x 6n) on the first use of its route (``Model._dense_system``): a 5,000-body model
+    would otherwise hold 7 GB for it, a 10,000-body chain 6.4 GB for the others."""
     n, nu = model.n_frames, model.nu
     model._qfull = np.zeros(model._nq_full)
     model._ufull = np.zeros(model._nu_full)
@@ -200,12 +210,12 @@ def workspace(model, joints):
     model._R = np.zeros((n, 3, 3))
     model._r, model._w, model._v = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))
     model._alpha, model._a = np.zeros((n, 3)), np.zeros((n, 3))
-    model._JR = np.zeros((n, 3, nu))
-    model._JT = np.zeros((n, 3, nu))
+    model._JR, model._JT = np.zeros((0, 3, nu)), np.zeros((0, 3, nu))
+    model._anc_ptr, model._anc_idx = np.zeros(0, np.int64), np.zeros(0, np.int64)
+    model._S = np.zeros((n, 6, 6))
     model._F, model._N = np.zeros((n, 3)), np.zeros((n, 3))
-    model._M = np.zeros((nu, nu))
+    model._M, model._L = np.zeros((0, 0)), np.zeros((0, 0))
     model._f = np.zeros(nu)
-    model._L = np.zeros((nu, nu))
     model._ud = np.zeros(nu)
     # articulated bodies (kernels.articulated): per frame 6x6 inertias, biases, the
     # joint's U = IA S and Cholesky factor of D, accelerations, joint wrenches
@@ -220,15 +230,37 @@ def workspace(model, joints):
 def pack(model):
     """Move every array the fused kernels use into two flat buffers (``kernels.packed``):
     the attributes become views of them, and a kernel call passes three arrays instead of
-    38."""
+    38.  The (empty) arrays of ``full_workspace`` stay where they are, entered in the
+    offset table by address."""
     attr = {name: "gravity" if name == "gravity" else "_" + name
-            for name in kp.FLOATS + kp.INTS}
+            for name in kp.FLOATS + kp.INTS + kp.FAR}
     fbuf, ibuf, table, views = kp.pack(
         {k: getattr(model, attr[k]) for k in kp.FLOATS},
-        {k: getattr(model, attr[k]) for k in kp.INTS})
+        {k: getattr(model, attr[k]) for k in kp.INTS},
+        {k: getattr(model, attr[k]) for k in kp.FAR})
     for name, view in views.items():
         setattr(model, attr[name], view)
     model._packed = (fbuf, ibuf, table)
+
+
+def full_workspace(model):
+    """Allocate, on the first use of a route that reads them, the arrays no O(n) route
+    needs: the full Jacobians ``JR``, ``JT`` (n x 3 x nu each), ``M`` and its Cholesky
+    factor ``L`` (nu x nu each) and the ancestor-column lists (``columns``); enter them
+    in the packed table (``kernels.packed.place``) and in the argument groups, and set
+    the model's Jourdain kernels (``Model._jourdain_kernel``, ``_jourdain_rates``: ``None``
+    before, so that a call checks one attribute).  The packed buffers, and every view of
+    them, stay as they are.  Kept from then on; a no-op when done."""
+    if model._jourdain_kernel is not None:
+        return
+    n, nu = model.n_frames, model.nu
+    model._anc_ptr, model._anc_idx = columns(model)
+    model._JR, model._JT = np.zeros((n, 3, nu)), np.zeros((n, 3, nu))
+    model._M, model._L = np.zeros((nu, nu)), np.zeros((nu, nu))
+    kp.place(model._packed[2], {k: getattr(model, "_" + k) for k in kp.FAR})
+    argument_groups(model)
+    model._jourdain_kernel = kp.jourdain_accelerations_packed
+    model._jourdain_rates = kp.state_derivative_packed
 
 
 def argument_groups(model):
@@ -243,7 +275,7 @@ def argument_groups(model):
                            model._force_int if model._force_int.shape[0] else None,
                            model._force_data, model._switches)
     model._kin_out = (model._R, model._r, model._w, model._v, model._alpha, model._a,
-                      model._JR, model._JT, model._F, model._N)
+                      model._JR, model._JT, model._S, model._F, model._N)
 
 
 def constraints(model, loop_joints):
@@ -258,6 +290,7 @@ def constraints(model, loop_joints):
         model.constraint_rows = ()
         model._row_joint = model._prim_joint = ()
         return
+    full_workspace(model)          # the constraints' Jacobian reads the full JR, JT
     con_int, con_data, labels, owners, prim_owner = pack_constraints(model, loop_joints)
     m = constraint_count(con_int)
     model.constraint_rows = labels

@@ -96,6 +96,8 @@ class LowLevel:
                              f"{', '.join(ROUTES)} (or 'auto')")
         self.model = model
         self.method = method
+        if method == "jourdain":
+            model._full_workspace()
         self._fd, self._sd = (_entry(f, sig) for f, sig in zip(ROUTES[method], SIGNATURES))
         self._fb, self._ib, _ = model._packed
         self._ud = model._ud

@@ -52,7 +52,6 @@ class Model:
         self.n_frames = len(bodies)
         layout.tree(self, joints)
         layout.coordinates(self, joints)
-        layout.columns(self, joints)
         layout.bodies(self, bodies)
         layout.reactions(self, joints)
         load_functions = layout.loads(self, loads)
@@ -66,6 +65,9 @@ class Model:
         self._force_int, self._force_data, laws = pack_forces(self, forces)
         self._switches = np.array([1 if self.gyroscopic else 0], np.int64)
         layout.workspace(self, joints)
+        #: the Jourdain route's packed kernels (forward dynamics, state derivative): set
+        #: with the arrays they read, on first use (layout.full_workspace)
+        self._jourdain_kernel = self._jourdain_rates = None
         layout.pack(self)
         #: (load name, the row of the load array its function fills, the function)
         self._load_functions = [(name, getattr(self, target)[k], fn)
@@ -163,6 +165,7 @@ class Model:
     _reactions_from = ne.reactions_from
     _raise_singular = diagnosis.raise_singular
     _division_by_zero = inputs.division_by_zero
+    _full_workspace = layout.full_workspace
 
     # ------------------------------------------------------------------ the numeric API
     kinematics = motion.kinematics
@@ -204,7 +207,9 @@ class Model:
 
     def _dense_system(self):
         """``(A, b)``: the workspace of the dense Newton-Euler system (6n x 6n and 6n),
-        allocated on the first use of that route and kept."""
+        allocated on the first use of that route and kept (with the full Jacobians it
+        reads, ``_full_workspace``)."""
+        self._full_workspace()
         if getattr(self, "_A", None) is None:
             self._A = np.zeros((6 * self.n_frames, 6 * self.n_frames))
             self._b = np.zeros(6 * self.n_frames)
@@ -242,18 +247,20 @@ class Model:
         drive_q = np.array([d[1] for d in self._driven], np.int64)
         drive_u = np.array([d[2] for d in self._driven], np.int64)
         body = (self._mass, self._com, self._inertia, self._has_inertia, self.gravity)
-        ws = (self._qfull, self._ufull, self._udfull, self._R, self._r, self._w, self._v,
-              self._alpha, self._a, self._JR, self._JT, self._F, self._N)
-        tree = self._tree
-        if method == "jourdain" and self._con is not None:
-            ws += (self._M, self._f, self._L, self._scratch, self._con)   # closed loops
-        elif method == "jourdain":
-            ws += (self._M, self._f, self._L, self._scratch)
-        elif method == "articulated":
-            ws += (self._IA, self._pA, self._cb, self._U, self._Dl, self._acc, self._scratch)
-            tree = tree[:9] + (self._own_ptr, self._own_idx)
+        if method == "jourdain":
+            self._full_workspace()
+            tree, work = self._tree, (self._M, self._f, self._L)
+        elif method == "articulated":   # no ancestor lists: no full Jacobians computed
+            none = np.zeros(0, np.int64)
+            tree = self._tree[:9] + (none, none)
+            work = (self._IA, self._pA, self._cb, self._U, self._Dl, self._acc)
         else:
             raise ModelError(f"loop_arguments: no compiled loop for method {method!r}")
+        ws = (self._qfull, self._ufull, self._udfull, self._R, self._r, self._w, self._v,
+              self._alpha, self._a, self._JR, self._JT, self._S, self._F, self._N, *work,
+              self._scratch)
+        if method == "jourdain" and self._con is not None:
+            ws += (self._con,)          # closed loops (kernels.routes)
         return (self.nq, slots, quats, self._free_q, self._free_u, drive_q, drive_u,
                 tree, body, self._loads_arrays, ws)
 

@@ -16,7 +16,9 @@ the world origin: a far-away body would lose digits to ``m |r|^2``), ordered
   origin ``O_i``;
 * force: ``W = (n, f)``, a moment about ``O_i`` and a force;
 * a joint's motion subspace ``S_i``: its own columns of ``JR`` and ``JT`` (the frame's
-  angular velocity and origin velocity per unit speed of its own joint).
+  angular velocity and origin velocity per unit speed of its own joint), which the
+  kinematics write compactly into ``S[i]`` (6 x 6: rows angular then linear, a column per
+  speed of the joint): the full Jacobians, n x 3 x nu, are not needed.
 
 Moving from a parent's origin to the child's (``rho = O_i - O_p``):
 ``X A_p = (alpha_p, a_p + alpha_p x rho)`` for motion, ``X^T W = (n + rho x f, f)`` brings
@@ -149,12 +151,12 @@ def _add_shifted_translational_inertia(IA, i, p, rho, T):
 
 
 @njit(**UNCOUNTED)
-def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a_b, JR, JT,
-                     F, N, IA, pA, cb, U, Dl, acc, ud, work):
+def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a_b, S, F, N,
+                     IA, pA, cb, U, Dl, acc, ud, work):
     """Forward dynamics ``ud`` by the articulated-body algorithm (see the module
     docstring), from the kinematics of ``forward_kinematics`` evaluated with ``u' = 0`` for
-    the free speeds (bias accelerations ``alpha_b``, ``a_b``; only the frames' own columns
-    of ``JR``/``JT`` are read) and the applied loads ``F``, ``N`` at the centres of mass.
+    the free speeds (bias accelerations ``alpha_b``, ``a_b``; the joints' motion subspaces
+    ``S``) and the applied loads ``F``, ``N`` at the centres of mass.
 
     Workspace, per frame: ``IA`` (6x6) articulated inertia, then ``Ia``, the part the
     parent sees; ``pA`` (6) bias force, then ``pa``; ``cb`` (6) the joint's bias
@@ -242,22 +244,20 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
             # zero translation columns: their terms, which come last, are skipped.
             turns = kd == REVOLUTE or kd == EULER or kd == SPHERICAL
             for j in range(k):
-                col = col0 + j
-                s0, s1, s2 = JR[i, 0, col], JR[i, 1, col], JR[i, 2, col]
+                s0, s1, s2 = S[i, 0, j], S[i, 1, j], S[i, 2, j]
                 for a_ in range(6):
                     s = IA[i, a_, 0] * s0 + IA[i, a_, 1] * s1 + IA[i, a_, 2] * s2
                     if not turns:
-                        s += (IA[i, a_, 3] * JT[i, 0, col] + IA[i, a_, 4] * JT[i, 1, col]
-                              + IA[i, a_, 5] * JT[i, 2, col])
+                        s += (IA[i, a_, 3] * S[i, 3, j] + IA[i, a_, 4] * S[i, 4, j]
+                              + IA[i, a_, 5] * S[i, 5, j])
                     U[i, a_, j] = s
             for j in range(k):
                 for m in range(j + 1):
-                    col = col0 + m
-                    s = (JR[i, 0, col] * U[i, 0, j] + JR[i, 1, col] * U[i, 1, j]
-                         + JR[i, 2, col] * U[i, 2, j])
+                    s = (S[i, 0, m] * U[i, 0, j] + S[i, 1, m] * U[i, 1, j]
+                         + S[i, 2, m] * U[i, 2, j])
                     if not turns:
-                        s += (JT[i, 0, col] * U[i, 3, j] + JT[i, 1, col] * U[i, 4, j]
-                              + JT[i, 2, col] * U[i, 5, j])
+                        s += (S[i, 3, m] * U[i, 3, j] + S[i, 4, m] * U[i, 4, j]
+                              + S[i, 5, m] * U[i, 5, j])
                     for l_ in range(m):
                         s -= Dl[i, j, l_] * Dl[i, m, l_]
                     if m == j:
@@ -271,10 +271,9 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
             # the joint's own equations: S^T (IA A + pA) = 0  ->  u' = D^-1 (uv - U^T X A_p)
             # keep z = D^-1 (-S^T pA) in Dl[i, :k, 6]
             for j in range(k):
-                col = col0 + j
-                v6[j] = -(JR[i, 0, col] * pA[i, 0] + JR[i, 1, col] * pA[i, 1]
-                          + JR[i, 2, col] * pA[i, 2] + JT[i, 0, col] * pA[i, 3]
-                          + JT[i, 1, col] * pA[i, 4] + JT[i, 2, col] * pA[i, 5])
+                v6[j] = -(S[i, 0, j] * pA[i, 0] + S[i, 1, j] * pA[i, 1]
+                          + S[i, 2, j] * pA[i, 2] + S[i, 3, j] * pA[i, 3]
+                          + S[i, 4, j] * pA[i, 4] + S[i, 5, j] * pA[i, 5])
             _cholesky_solve_small(Dl, inv, i, k, v6)
             for j in range(k):
                 Dl[i, j, 6] = v6[j]
@@ -359,12 +358,10 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
                 v6[j] = s
             _cholesky_solve_small(Dl, inv, i, k, v6)
             for j in range(k):
-                col = col0 + j
                 udj = Dl[i, j, 6] - v6[j]
-                ud[col] = udj
-                for a_ in range(3):
-                    acc[i, a_] += JR[i, a_, col] * udj
-                    acc[i, 3 + a_] += JT[i, a_, col] * udj
+                ud[col0 + j] = udj
+                for a_ in range(6):
+                    acc[i, a_] += S[i, a_, j] * udj
     return -1
 
 

@@ -148,7 +148,7 @@ def constrained_accelerations(tree, body, state, loads, motion, jourdain, con, s
     ``jourdain_accelerations`` (-1 done; a pivot where neither ``M`` nor the augmented
     system determines ``u'``; -2 non-finite)."""
     M, f, L, ud = jourdain
-    R, r, w, v, alpha, a, JR, JT, F, N = motion
+    R, r, w, v, alpha, a, JR, JT, S, F, N = motion
     qfull, ufull, udfull = state
     con_int, con_data, phi, psi, G, gamma, lam, info = con
     pivot = jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch)
@@ -184,7 +184,7 @@ def project_state(y, nq, slots, quats, free_q, free_u, tree, state, motion, con,
     not converge."""
     parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx = tree
     qfull, ufull, udfull = state
-    R, r, w, v, alpha, a, JR, JT, F, N = motion
+    R, r, w, v, alpha, a, JR, JT, S, F, N = motion
     con_int, con_data, phi, psi, G, gamma, lam, info = con
     nu = y.shape[0] - nq
     dq = np.empty(nq)
@@ -195,7 +195,7 @@ def project_state(y, nq, slots, quats, free_q, free_u, tree, state, motion, con,
         for k in range(nu):
             ufull[free_u[k]] = y[nq + k]
         walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull,
-             ufull, udfull, R, r, w, v, alpha, a, JR, JT, scratch)
+             ufull, udfull, R, r, w, v, alpha, a, JR, JT, S, scratch)
         constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
                         R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma)
         if residual_norm(phi) <= PROJECTION_TOLERANCE:
@@ -253,10 +253,10 @@ def constraint_state(tree, state, motion, con, scratch):
     of ``phi``, ``psi``, ``G``, ``gamma``)."""
     parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx = tree
     qfull, ufull, udfull = state
-    R, r, w, v, alpha, a, JR, JT, F, N = motion
+    R, r, w, v, alpha, a, JR, JT, S, F, N = motion
     con_int, con_data, phi, psi, G, gamma, lam, info = con
     walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull, ufull,
-         udfull, R, r, w, v, alpha, a, JR, JT, scratch)
+         udfull, R, r, w, v, alpha, a, JR, JT, S, scratch)
     constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma)
 

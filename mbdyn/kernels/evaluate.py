@@ -32,12 +32,12 @@ def kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_
                          mass, com, gravity, qfull, ufull, udfull,
                          load_body, load_point, load_force, load_moment, load_in_body,
                          force_int, force_data, switches,
-                         R, r, w, v, alpha, a, JR, JT, F, N, scratch):
+                         R, r, w, v, alpha, a, JR, JT, S, F, N, scratch):
     """Motion of every frame, then the applied loads ``F``, ``N``: gravity, point loads
     and force elements.  ``force_int`` is None for a model without force elements: a type,
     not a count, so that numba prunes the call and compiles no force kernel for it."""
     walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull, ufull,
-         udfull, R, r, w, v, alpha, a, JR, JT, scratch)
+         udfull, R, r, w, v, alpha, a, JR, JT, S, scratch)
     applied_loads(mass, com, gravity, R, r, load_body, load_point, load_force, load_moment,
                   load_in_body, F, N, scratch)
     if force_int is not None and force_int.shape[0]:
@@ -47,7 +47,7 @@ def kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_
 
 @njit(**UNCOUNTED)
 def drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
-                           qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, scratch):
+                           qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S, scratch):
     """The ``gyroscopic`` effect switched off: the motion again with every speed zero, so
     that the bias accelerations keep only the prescribed (drive) accelerations and
     ``w x I w`` vanishes; the applied loads computed before keep the true velocities."""
@@ -57,7 +57,7 @@ def drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, an
         saved[k] = ufull[k]
         ufull[k] = 0.0
     walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull, ufull,
-         udfull, R, r, w, v, alpha, a, JR, JT, scratch)
+         udfull, R, r, w, v, alpha, a, JR, JT, S, scratch)
     for k in range(nuf):
         ufull[k] = saved[k]
 
@@ -72,7 +72,7 @@ def jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch):
     """Kinematics, loads, ``M`` and ``f``, then ``ud = M^-1 f`` by Cholesky.  The groups:
     ``tree`` (``parent .. anc_idx``), ``body`` (``mass, com, inertia, has_inertia,
     gravity``), ``state`` (``qfull, ufull, udfull``), ``loads`` (``load_body ..
-    switches``), ``motion`` (``R, r, w, v, alpha, a, JR, JT, F, N``), ``jourdain`` (``M, f,
+    switches``), ``motion`` (``R, r, w, v, alpha, a, JR, JT, S, F, N``), ``jourdain`` (``M, f,
     L, ud``).
 
     Returns -1 on success, the index of the speed where the Cholesky factorisation broke
@@ -83,16 +83,16 @@ def jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch):
     qfull, ufull, udfull = state
     (load_body, load_point, load_force, load_moment, load_in_body, force_int, force_data,
      switches) = loads
-    R, r, w, v, alpha, a, JR, JT, F, N = motion
+    R, r, w, v, alpha, a, JR, JT, S, F, N = motion
     M, f, L, ud = jourdain
     kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                          mass, com, gravity, qfull, ufull, udfull,
                          load_body, load_point, load_force, load_moment, load_in_body,
-                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, F, N,
-                         scratch)
+                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, S, F,
+                         N, scratch)
     if switches[0] == 0:
         drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr,
-                               anc_idx, qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT,
+                               anc_idx, qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S,
                                scratch)
     jourdain_terms(mass, com, inertia, has_inertia, R, r, w, alpha, a, JR, JT, anc_ptr,
                    anc_idx, parent, F, N, M, f, scratch)
@@ -111,7 +111,7 @@ def newton_euler_solution(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc
                           load_body, load_point, load_force, load_moment, load_in_body,
                           force_int, force_data, switches,
                           react_joint, react_force, react_moment,
-                          R, r, w, v, alpha, a, JR, JT, F, N, A, b, scratch):
+                          R, r, w, v, alpha, a, JR, JT, S, F, N, A, b, scratch):
     """Kinematics, loads, the Newton-Euler system with reactions, solved by LU.
 
     Returns the unknowns ``x = [ud, lambda]`` (a new array).
@@ -119,11 +119,11 @@ def newton_euler_solution(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc
     kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                          mass, com, gravity, qfull, ufull, udfull,
                          load_body, load_point, load_force, load_moment, load_in_body,
-                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, F, N,
-                         scratch)
+                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, S, F,
+                         N, scratch)
     if switches[0] == 0:
         drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr,
-                               anc_idx, qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT,
+                               anc_idx, qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S,
                                scratch)
     newton_euler_system(mass, com, inertia, parent, R, r, w, alpha, a, JR, JT, anc_ptr, anc_idx,
                         F, N, react_joint, react_force, react_moment, A, b)
@@ -136,29 +136,30 @@ def articulated_accelerations(tree, body, state, loads, motion, work, ud, scratc
     as ``jourdain_accelerations``'s, except ``body`` (``mass, com, inertia, gravity``) and
     ``work`` (``IA, pA, cb, U, Dl, acc``, the algorithm's workspace).
 
-    ``tree`` ends with ``own_ptr``/``own_idx``: each frame's own speed columns only (in
-    place of the ancestor lists), so that the kinematics skip the O(n depth) inheritance of
-    Jacobian columns the algorithm does not read.  Returns -1 on success, the speed where a
-    degree of freedom has no inertia, or -2 when ``ud`` holds NaN or Inf.
+    ``tree`` ends with empty ancestor lists ``anc_ptr``, ``anc_idx``: the kinematics then
+    write each frame's own Jacobian columns into ``S`` only, all the algorithm reads, and
+    skip the full Jacobians (n x 3 x nu floats each, O(n depth) work; they may be
+    unallocated).  Returns -1 on success, the speed where a degree of freedom has no
+    inertia, or -2 when ``ud`` holds NaN or Inf.
     """
-    parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr, own_idx = tree
+    parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx = tree
     mass, com, inertia, gravity = body
     qfull, ufull, udfull = state
     (load_body, load_point, load_force, load_moment, load_in_body, force_int, force_data,
      switches) = loads
-    R, r, w, v, alpha, a, JR, JT, F, N = motion
+    R, r, w, v, alpha, a, JR, JT, S, F, N = motion
     IA, pA, cb, U, Dl, acc = work
-    kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr, own_idx,
+    kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                          mass, com, gravity, qfull, ufull, udfull,
                          load_body, load_point, load_force, load_moment, load_in_body,
-                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, F, N,
-                         scratch)
+                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, S, F,
+                         N, scratch)
     if switches[0] == 0:
-        drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr,
-                               own_idx, qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT,
+        drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr,
+                               anc_idx, qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S,
                                scratch)
-    pivot = articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha, a, JR, JT,
-                             F, N, IA, pA, cb, U, Dl, acc, ud, scratch)
+    pivot = articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha, a, S, F,
+                             N, IA, pA, cb, U, Dl, acc, ud, scratch)
     if pivot >= 0:
         return pivot
     for k in range(ud.shape[0]):
@@ -168,20 +169,21 @@ def articulated_accelerations(tree, body, state, loads, motion, work, ud, scratc
 
 
 @njit(**UNCOUNTED)
-def newton_euler_tree(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr, own_idx,
+def newton_euler_tree(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                       mass, com, inertia, gravity, qfull, ufull, udfull,
                       load_body, load_point, load_force, load_moment, load_in_body,
                       force_int, force_data, switches, react_joint, react_force, react_moment,
-                      R, r, w, v, alpha, a, JR, JT, F, N, IA, pA, cb, U, Dl, acc, wrench, ud,
+                      R, r, w, v, alpha, a, JR, JT, S, F, N, IA, pA, cb, U, Dl, acc, wrench, ud,
                       lam, scratch):
     """The Newton-Euler equations with reaction unknowns solved in tree order: speed rates
     ``ud`` and reaction components ``lam`` (as ``newton_euler_solution``'s ``x``), in O(n).
     Returns as ``articulated_accelerations`` (-2 also for non-finite reactions)."""
     pivot = articulated_accelerations(
-        (parent, kind, axis, seq, pos, C, qoff, uoff, ucol, own_ptr, own_idx),
+        (parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx),
         (mass, com, inertia, gravity), (qfull, ufull, udfull),
         (load_body, load_point, load_force, load_moment, load_in_body, force_int, force_data,
-         switches), (R, r, w, v, alpha, a, JR, JT, F, N), (IA, pA, cb, U, Dl, acc), ud, scratch)
+         switches), (R, r, w, v, alpha, a, JR, JT, S, F, N), (IA, pA, cb, U, Dl, acc), ud,
+        scratch)
     if pivot != -1:
         return pivot
     joint_wrenches_tree(parent, r, IA, pA, acc, wrench, scratch)

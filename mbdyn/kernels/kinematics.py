@@ -7,7 +7,12 @@ All outputs are in inertial (world) components unless a name says otherwise:
 * ``r, v, a`` -- position, velocity, acceleration of frame i's origin;
 * ``w, alpha`` -- absolute angular velocity and acceleration of frame i;
 * ``JR[i]``, ``JT[i]`` -- Jacobians of rotation ``dw_i/du`` and of translation of the
-  origin ``dv_i/du``, over the free speeds ``u`` (driven joints have no column).
+  origin ``dv_i/du``, over the free speeds ``u`` (driven joints have no column);
+* ``S[i]`` -- the same Jacobians' columns of frame i's own joint only, compactly: its
+  motion subspace, ``S[i, :3, c]`` of rotation and ``S[i, 3:, c]`` of translation for the
+  joint's ``c``-th free speed (all the articulated-body route reads: n x 6 x 6 floats,
+  where ``JR`` and ``JT`` are n x 3 x nu each); written in their place when the walk is
+  given no ancestor lists.
 
 The accelerations use the speed rates passed in ``udfull``: with zeros for the free
 speeds they are the velocity-product ("bias") accelerations, so that
@@ -35,26 +40,29 @@ KINEMATICS_WORK = 5 * 9 + 2 * 3 * MAX_NU + 4 * 9 + 8 * 3 + 25 * 3 + 1
 
 @njit(cache=True)
 def forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
-                       qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT):
+                       qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S):
     """Motion of every frame and the Jacobians at frame origins (see module docstring).
 
     ``anc_idx[anc_ptr[i]:anc_ptr[i+1]]`` lists the free-speed columns on which frame i
     depends (its own joint's and its ancestors'); the other columns of ``JR[i]`` and
-    ``JT[i]`` are zero and are never written, so the caller zeroes them once.
+    ``JT[i]`` are zero and are never written, so the caller zeroes them once.  ``S`` is
+    written instead of them when ``anc_ptr`` is empty (the full Jacobians may then be
+    empty too): the articulated-body route's kinematics.
     """
     walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull, ufull,
-         udfull, R, r, w, v, alpha, a, JR, JT, np.empty(KINEMATICS_WORK))
+         udfull, R, r, w, v, alpha, a, JR, JT, S, np.empty(KINEMATICS_WORK))
 
 
 @njit(**UNCOUNTED)
 def walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull, ufull,
-         udfull, R, r, w, v, alpha, a, JR, JT, work):
+         udfull, R, r, w, v, alpha, a, JR, JT, S, work):
     """``forward_kinematics`` in the scratch ``work`` (at least ``KINEMATICS_WORK``
     floats): it allocates nothing, so that it can run uncounted (``views.UNCOUNTED``)."""
     # long: steps 1-6 of the textbook for one frame after another in one loop (rotation,
     # position, velocities, accelerations, Jacobian columns): numba passes rows of the
     # parent's results through the scratch, not as arguments of helper calls.
     n = parent.shape[0]
+    full = anc_ptr.shape[0] > 0
     # Per-frame rows are copied into this scratch, element by element, rather than passed
     # on as views (R[p], w[p], ...): each view costs reference-count calls, which cost
     # more than the arithmetic of a small model; the scratch views (c_view) cost none.
@@ -168,8 +176,9 @@ def walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qf
                 alpha[i, k] = t3[k]
                 a[i, k] = t4[k]
 
-        # Jacobians: inherit the parent's columns, then add this joint's own
-        if p >= 0:
+        # Jacobians: inherit the parent's columns, then add this joint's own (into the full
+        # Jacobians when they are wanted, else into S)
+        if full and p >= 0:
             for m in range(anc_ptr[p], anc_ptr[p + 1]):
                 col = anc_idx[m]
                 jr0, jr1, jr2 = JR[p, 0, col], JR[p, 1, col], JR[p, 2, col]
@@ -184,9 +193,15 @@ def walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qf
             for c in range(nu):
                 col = ucol[i] + c
                 for k in range(3):
-                    JR[i, k, col] = Ri[k, 0] * Hw[0, c] + Ri[k, 1] * Hw[1, c] + Ri[k, 2] * Hw[2, c]
-                    JT[i, k, col] = 0.0 if turns else (RJ0[k, 0] * Hv[0, c] + RJ0[k, 1] * Hv[1, c]
-                                                       + RJ0[k, 2] * Hv[2, c])
+                    sr = Ri[k, 0] * Hw[0, c] + Ri[k, 1] * Hw[1, c] + Ri[k, 2] * Hw[2, c]
+                    st = 0.0 if turns else (RJ0[k, 0] * Hv[0, c] + RJ0[k, 1] * Hv[1, c]
+                                            + RJ0[k, 2] * Hv[2, c])
+                    if full:
+                        JR[i, k, col] = sr
+                        JT[i, k, col] = st
+                    else:
+                        S[i, k, c] = sr
+                        S[i, 3 + k, c] = st
 
 
 @njit(**UNCOUNTED)

@@ -11,6 +11,11 @@ buffer, so the Python side keeps using its arrays as before.
 The Jourdain entry points also scatter the free coordinates and speeds into the joint-space
 state (what ``Model._fill`` does in Python for the other evaluations); drives and loads
 given as Python functions are still written by the caller first.
+
+The arrays only the Jourdain and dense Newton-Euler routes read, O(n nu) and O(nu^2),
+are not in the buffers (``FAR``): allocated on the first use of such a route, they are
+entered into the offset table by address (``place``), so that the buffers, and every view
+of them held anywhere, stay as they are.
 """
 import numpy as np
 from numba import njit
@@ -19,45 +24,59 @@ from .evaluate import (articulated_accelerations, jourdain_accelerations, newton
                        newton_euler_tree)
 from .forces import ROW
 from .joints import coordinate_rates
-from .views import UNCOUNTED, c_view, untracked
+from .views import UNCOUNTED, c_view, far_view, untracked
 
 #: float arrays in buffer order, with their shapes in terms of the sizes below
 FLOATS = ("gravity", "axis", "pos", "C", "mass", "com", "inertia", "load_point", "load_force",
           "load_moment", "react_force", "react_moment", "qfull", "ufull", "udfull", "R", "r",
-          "w", "v", "alpha", "a", "JR", "JT", "F", "N", "M", "f", "L", "ud",
+          "w", "v", "alpha", "a", "S", "F", "N", "f", "ud",
           "force_data", "IA", "pA", "cb", "U", "Dl", "acc", "W", "lam", "scratch")
 #: integer arrays in buffer order (the two flags, has_inertia and load_in_body, as 0/1)
-INTS = ("parent", "kind", "seq", "qoff", "uoff", "ucol", "anc_ptr", "anc_idx", "has_inertia",
+INTS = ("parent", "kind", "seq", "qoff", "uoff", "ucol", "has_inertia",
         "load_body", "load_in_body", "react_joint", "free_q", "free_u", "slots", "force_int",
-        "switches", "own_ptr", "own_idx")
+        "switches")
+#: arrays kept outside the two buffers, whose table entries are addresses (``place``):
+#: those only the Jourdain and dense Newton-Euler routes read -- the full Jacobians
+#: (n x 3 x nu each), ``M`` and its factor ``L`` (nu x nu each), the ancestor-column
+#: lists (O(n depth)) --, of size zero until a route first needs them
+#: (``compiled.layout.full_workspace``): a 10,000-body chain would otherwise hold 6.4 GB
+FAR = ("JR", "JT", "M", "L", "anc_ptr", "anc_idx")
 #: sizes, first entries of the offset table: frames, free speeds, loads, joint-space
 #: coordinates and speeds, ancestor-column entries, reaction components, free coordinates,
-#: free joints, force elements, force-element numbers, scratch floats
+#: free joints, force elements, force-element numbers, scratch floats; then the sizes of
+#: the ``FAR`` arrays: frames with full Jacobians (n or 0), rows of ``M`` (nu or 0),
+#: entries of ``anc_ptr`` (n + 1 or 0)
 SIZES = ("n", "nu", "nl", "nqf", "nuf", "nanc", "nreact", "nq", "nslots", "ne", "nfd",
-         "nscratch")
+         "nscratch", "nj", "nm", "nptr")
+NANC, NJ, NM, NPTR = 5, 12, 13, 14
 
 (GRAVITY, AXIS, POS, C, MASS, COM, INERTIA, LOAD_POINT, LOAD_FORCE, LOAD_MOMENT, REACT_FORCE,
- REACT_MOMENT, QFULL, UFULL, UDFULL, R, RR, W, V, ALPHA, A, JR, JT, F, N, M, FF, L,
+ REACT_MOMENT, QFULL, UFULL, UDFULL, R, RR, W, V, ALPHA, A, S, F, N, FF,
  UD, FORCE_DATA, IA, PA, CB, U, DL, ACC, WRENCH, LAM, SCRATCH) = range(len(SIZES),
                                                                 len(SIZES) + len(FLOATS))
-(PARENT, KIND, SEQ, QOFF, UOFF, UCOL, ANC_PTR, ANC_IDX, HAS_INERTIA, LOAD_BODY, LOAD_IN_BODY,
- REACT_JOINT, FREE_Q, FREE_U, SLOTS, FORCE_INT, SWITCHES, OWN_PTR, OWN_IDX) = range(len(SIZES) + len(FLOATS), len(SIZES) + len(FLOATS) + len(INTS))
+(PARENT, KIND, SEQ, QOFF, UOFF, UCOL, HAS_INERTIA, LOAD_BODY, LOAD_IN_BODY,
+ REACT_JOINT, FREE_Q, FREE_U, SLOTS, FORCE_INT, SWITCHES) = range(len(SIZES) + len(FLOATS),
+                                                                 len(SIZES) + len(FLOATS)
+                                                                 + len(INTS))
+(JR, JT, M, L, ANC_PTR, ANC_IDX) = range(len(SIZES) + len(FLOATS) + len(INTS),
+                                         len(SIZES) + len(FLOATS) + len(INTS) + len(FAR))
 
 
-def pack(floats, ints):
+def pack(floats, ints, far):
     """Copy the arrays of ``floats`` and ``ints`` (dicts by the names in ``FLOATS``,
-    ``INTS``) into two buffers.  Returns ``(fbuf, ibuf, table, views)``: ``table`` holds the
-    sizes (``SIZES``) and then each array's offset; ``views[name]`` is the array's view.
+    ``INTS``) into two buffers, and ``place`` the arrays of ``far``.  Returns ``(fbuf,
+    ibuf, table, views)``: ``table`` holds the sizes (``SIZES``), then each array's
+    offset, then the ``FAR`` arrays' addresses; ``views[name]`` is the array's view.
     The table is also the head of ``ibuf`` (``table`` is that view): ``ibuf`` can stand for
     the table, so that an entry point takes one array less (``mbdyn.compiled.lowlevel``)."""
-    sizes = {"n": floats["mass"].shape[0], "nu": floats["M"].shape[0],
+    sizes = {"n": floats["mass"].shape[0], "nu": floats["ud"].shape[0],
              "nl": floats["load_force"].shape[0], "nqf": floats["qfull"].shape[0],
-             "nuf": floats["ufull"].shape[0], "nanc": ints["anc_idx"].shape[0],
-             "nreact": ints["react_joint"].shape[0], "nq": ints["free_q"].shape[0],
-             "nslots": ints["slots"].shape[0], "ne": ints["force_int"].shape[0],
-             "nfd": floats["force_data"].shape[0], "nscratch": floats["scratch"].shape[0]}
-    table = np.zeros(len(SIZES) + len(FLOATS) + len(INTS), np.int64)
-    table[:len(SIZES)] = [sizes[s] for s in SIZES]
+             "nuf": floats["ufull"].shape[0], "nreact": ints["react_joint"].shape[0],
+             "nq": ints["free_q"].shape[0], "nslots": ints["slots"].shape[0],
+             "ne": ints["force_int"].shape[0], "nfd": floats["force_data"].shape[0],
+             "nscratch": floats["scratch"].shape[0]}
+    table = np.zeros(len(SIZES) + len(FLOATS) + len(INTS) + len(FAR), np.int64)
+    table[:len(SIZES)] = [sizes.get(s, 0) for s in SIZES]
     views = {}
     for names, source, dtype in ((FLOATS, floats, np.float64), (INTS, ints, np.int64)):
         first = len(SIZES) + (0 if names is FLOATS else len(FLOATS))
@@ -77,20 +96,39 @@ def pack(floats, ints):
         else:
             ibuf = buf
     ibuf[:table.shape[0]] = table
-    return fbuf, ibuf, ibuf[:table.shape[0]], views
+    table = ibuf[:table.shape[0]]
+    place(table, far)
+    return fbuf, ibuf, table, views
+
+
+def place(table, far):
+    """Enter the arrays of ``far`` (a dict by the names in ``FAR``: float64 and int64,
+    C-contiguous) into ``table``: their sizes and addresses.  The caller keeps them alive
+    as long as the table is used, and calls no kernel on the table while it changes."""
+    for k, name in enumerate(FAR):
+        arr = far[name]
+        dtype = np.int64 if name.startswith("anc") else np.float64
+        if not (isinstance(arr, np.ndarray) and arr.flags.c_contiguous and arr.dtype == dtype):
+            raise TypeError(f"packed.place: {name} must be a C-contiguous {dtype.__name__} "
+                            "array")
+        table[JR + k] = arr.ctypes.data
+    table[NJ], table[NM] = far["JR"].shape[0], far["M"].shape[0]
+    table[NPTR], table[NANC] = far["anc_ptr"].shape[0], far["anc_idx"].shape[0]
 
 
 @njit(inline="always", **UNCOUNTED)
 def _views(fb, ib, t):
     """Every packed array as a view, in the order of the unpacked kernels' arguments:
     tree (11), body (mass, com, inertia, has_inertia, gravity), joint-space state (3),
-    loads (5, then force elements and effect switches: 3), reactions (3), motion (10),
-    Jourdain (M, f, L, ud), articulated bodies (the frames' own
-    columns ``own_ptr``, ``own_idx``, then the workspace of ``articulated.articulated_body``
-    and the joint wrenches and reaction components), and the evaluations' scratch.
-    Offsets are read from ``t`` at run time: literal constants as arguments would make
-    numba compile a slicing helper per constant."""
+    loads (5, then force elements and effect switches: 3), reactions (3), motion (11),
+    Jourdain (M, f, L, ud), articulated bodies (empty ancestor lists, which end the
+    tree of that route: ``evaluate.articulated_accelerations``; then the workspace of
+    ``articulated.articulated_body`` and the joint wrenches and reaction components), and
+    the evaluations' scratch.  Offsets and addresses are read from ``t`` at run time:
+    literal constants as arguments would make numba compile a slicing helper per
+    constant."""
     n, nu, nl, nqf, nuf, nanc, nreact = t[0], t[1], t[2], t[3], t[4], t[5], t[6]
+    nj, nm = t[NJ], t[NM]
     fb, ib = untracked(fb), untracked(ib)       # slices of them are untracked too
     tree = (ib[t[PARENT]:t[PARENT] + n], ib[t[KIND]:t[KIND] + n],
             c_view(fb, t[AXIS], (n, 3)),
@@ -98,7 +136,7 @@ def _views(fb, ib, t):
             c_view(fb, t[POS], (n, 3)),
             c_view(fb, t[C], (n, 3, 3)),
             ib[t[QOFF]:t[QOFF] + n], ib[t[UOFF]:t[UOFF] + n], ib[t[UCOL]:t[UCOL] + n],
-            ib[t[ANC_PTR]:t[ANC_PTR] + n + 1], ib[t[ANC_IDX]:t[ANC_IDX] + nanc])
+            far_view(ib, t[ANC_PTR], (t[NPTR],)), far_view(ib, t[ANC_IDX], (nanc,)))
     body = (fb[t[MASS]:t[MASS] + n], c_view(fb, t[COM], (n, 3)),
             c_view(fb, t[INERTIA], (n, 3, 3)),
             ib[t[HAS_INERTIA]:t[HAS_INERTIA] + n], fb[t[GRAVITY]:t[GRAVITY] + 3])
@@ -119,12 +157,13 @@ def _views(fb, ib, t):
               c_view(fb, t[V], (n, 3)),
               c_view(fb, t[ALPHA], (n, 3)),
               c_view(fb, t[A], (n, 3)),
-              c_view(fb, t[JR], (n, 3, nu)),
-              c_view(fb, t[JT], (n, 3, nu)),
+              far_view(fb, t[JR], (nj, 3, nu)),
+              far_view(fb, t[JT], (nj, 3, nu)),
+              c_view(fb, t[S], (n, 6, 6)),
               c_view(fb, t[F], (n, 3)), c_view(fb, t[N], (n, 3)))
-    jourdain = (c_view(fb, t[M], (nu, nu)), fb[t[FF]:t[FF] + nu],
-                c_view(fb, t[L], (nu, nu)), fb[t[UD]:t[UD] + nu])
-    articulated = (ib[t[OWN_PTR]:t[OWN_PTR] + n + 1], ib[t[OWN_IDX]:t[OWN_IDX] + nu],
+    jourdain = (far_view(fb, t[M], (nm, nm)), fb[t[FF]:t[FF] + nu],
+                far_view(fb, t[L], (nm, nm)), fb[t[UD]:t[UD] + nu])
+    articulated = (far_view(ib, t[ANC_PTR], (0,)), far_view(ib, t[ANC_IDX], (0,)),
                    c_view(fb, t[IA], (n, 6, 6)),
                    c_view(fb, t[PA], (n, 6)),
                    c_view(fb, t[CB], (n, 6)),

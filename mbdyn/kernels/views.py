@@ -21,6 +21,22 @@ from numba.np.arrayobj import make_array, populate_array
 UNCOUNTED = {"cache": True, "_nrt": False}
 
 
+def _view(context, builder, view_type, src, data, shape):
+    """The untracked C-contiguous array structure of ``view_type`` on ``data`` (a pointer
+    of ``src``'s element type) with the dimensions ``shape`` (a tuple value)."""
+    shapes = cgutils.unpack_tuple(builder, shape, view_type.ndim)
+    strides = [None] * view_type.ndim
+    stride = src.itemsize
+    for k in range(view_type.ndim - 1, -1, -1):           # C order
+        strides[k] = stride
+        stride = builder.mul(stride, shapes[k])
+    out = make_array(view_type)(context, builder)
+    populate_array(out, data=data, shape=shapes, strides=strides, itemsize=src.itemsize,
+                   meminfo=cgutils.get_null_value(src.meminfo.type),
+                   parent=cgutils.get_null_value(src.parent.type))
+    return impl_ret_untracked(context, builder, view_type, out._getvalue())
+
+
 @intrinsic
 def c_view(typingctx, buf, start, shape):
     """``buf[start:start + prod(shape)].reshape(shape)`` for a 1-d C-contiguous ``buf``,
@@ -34,24 +50,13 @@ def c_view(typingctx, buf, start, shape):
     if not (isinstance(buf, types.Array) and buf.ndim == 1 and buf.layout == "C"
             and isinstance(shape, types.UniTuple) and isinstance(start, types.Integer)):
         return None
-    ndim = shape.count
-    view_type = types.Array(buf.dtype, ndim, "C")
+    view_type = types.Array(buf.dtype, shape.count, "C")
 
     def codegen(context, builder, sig, args):
         src = make_array(sig.args[0])(context, builder, args[0])
-        shapes = cgutils.unpack_tuple(builder, args[2], ndim)
-        strides = [None] * ndim
-        stride = src.itemsize
-        for k in range(ndim - 1, -1, -1):           # C order
-            strides[k] = stride
-            stride = builder.mul(stride, shapes[k])
         first = context.cast(builder, args[1], sig.args[1], types.intp)
-        out = make_array(view_type)(context, builder)
-        null = cgutils.get_null_value(src.meminfo.type)
-        populate_array(out, data=builder.gep(src.data, [first]), shape=shapes,
-                       strides=strides, itemsize=src.itemsize, meminfo=null,
-                       parent=cgutils.get_null_value(src.parent.type))
-        return impl_ret_untracked(context, builder, view_type, out._getvalue())
+        return _view(context, builder, view_type, src, builder.gep(src.data, [first]),
+                     args[2])
     return view_type(buf, start, shape), codegen
 
 
@@ -84,3 +89,24 @@ def untracked(typingctx, value):
         return impl_ret_untracked(context, builder, sig.return_type,
                                   _untracked_value(context, builder, sig.args[0], args[0]))
     return value(value), codegen
+
+
+@intrinsic
+def far_view(typingctx, like, address, shape):
+    """A C-contiguous view of ``shape`` with ``like``'s element type on the memory at
+    ``address`` (an integer: ``ndarray.ctypes.data`` of an array kept elsewhere), built as
+    ``c_view`` builds its views: for the arrays of a packed model that live outside its
+    two buffers, allocated on first use (``packed.FAR``), whose addresses the offset table
+    holds.  The owner of that memory must outlive every use of the view; a view of size
+    zero is never read, whatever the address."""
+    if not (isinstance(like, types.Array) and isinstance(address, types.Integer)
+            and isinstance(shape, types.UniTuple)):
+        return None
+    view_type = types.Array(like.dtype, shape.count, "C")
+
+    def codegen(context, builder, sig, args):
+        src = make_array(sig.args[0])(context, builder, args[0])
+        at = context.cast(builder, args[1], sig.args[1], types.intp)
+        return _view(context, builder, view_type, src, builder.inttoptr(at, src.data.type),
+                     args[2])
+    return view_type(like, address, shape), codegen
