@@ -56,7 +56,8 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     DOP853, drives that ``mbdyn.compiled.programs`` translates); ``False`` forces the Python loop
     (scipy's solvers for RK45 and DOP853, which ``"scipy-RK45"`` and ``"scipy-DOP853"``
     also name).
-    ``decimate``: fixed-step schemes store every ``decimate``-th step (and the last).
+    ``decimate``: fixed-step schemes store every ``decimate``-th step (and the last); they
+    end on ``t_end`` exactly and interpolate ``t_eval`` between steps by cubic Hermite.
 
     Budgets (``mbdyn.limits``; ``docs/reliability.md``): ``max_steps`` integrator steps
     (default ``MAX_STEPS``), ``max_samples`` stored samples (default ``MAX_SAMPLES``;
