@@ -32,7 +32,8 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
              rtol=DEFAULTS["rtol"], atol=DEFAULTS["atol"], dt=None, method=DEFAULTS["method"],
              events=(), t_eval=None, max_step=np.inf, outputs=(), points=None, progress=None,
              singularity_threshold=1e-3, reactions_frame="world", compiled_loop=True,
-             decimate=1, max_steps=None, max_samples=None, max_wall_time=None):
+             decimate=1, max_steps=None, max_samples=None, max_wall_time=None,
+             error_estimate=False):
     """Integrate ``model`` (a compiled ``Model``, or a ``System`` to compile) from ``t0``
     to ``t_end``.
 
@@ -67,7 +68,9 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
 
     Statistics include the mass matrix's condition number at the start and the end (a
     ``SingularityWarning`` when it is large), the largest quaternion drift and, with
-    ``outputs=("energy",)``, the energy drift.
+    ``outputs=("energy",)``, the energy drift.  ``error_estimate``: run again at half the
+    step (fixed-step) or at rtol/100, atol/100 (adaptive); ``stats["error_estimate"]``
+    holds the difference per coordinate and speed (``quality.estimate_error``).
 
     Raises ``SimulationError`` (its ``result`` holds the motion up to the failure) when
     the integrator fails or NaN/Inf appears.
@@ -82,7 +85,8 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     budget["integrator"] = integrator
     t_eval = _check_t_eval(t_eval, t0, t_end)
     q, u = _initial_state(model, q0, u0)
-    events = [as_event(e, model) for e in events]
+    given_events = list(events)
+    events = [as_event(e, model) for e in given_events]
     if events:
         check_conditions(events, model, t0, q, u)
     rhs = RightHandSide(model, method)
@@ -113,6 +117,15 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     result = _result(model, outcome, stats, pre_stats, monitor)
     if outputs or points:
         result.compute_outputs(outputs, points, frame=reactions_frame)
+    if error_estimate:
+        from .quality import estimate_error
+        same = {"t0": t0, "integrator": integrator, "rtol": rtol, "atol": atol, "dt": dt,
+                "method": method, "events": given_events, "max_step": max_step,
+                "compiled_loop": compiled_loop, "max_steps": max_steps,
+                "singularity_threshold": singularity_threshold,
+                "max_samples": max_samples, "max_wall_time": max_wall_time}
+        estimate_error(result, lambda **kw: simulate(model, t_end, q, u, **{**same, **kw}),
+                       integrator, rtol, atol, dt)
     return result
 
 
