@@ -83,6 +83,7 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     budget = make_budget(max_steps, max_samples, max_wall_time, decimate)
     budget["drives"] = [d[0] for d in getattr(model, "_driven", ())]
     budget["integrator"] = integrator
+    budget.update(speeds=model.nu, span=t_end - t0)       # budget.warn_stiff's measures
     t_eval = _check_t_eval(t_eval, t0, t_end)
     q, u = _initial_state(model, q0, u0)
     given_events = list(events)
