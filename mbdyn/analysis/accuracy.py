@@ -104,10 +104,11 @@ REFERENCE_BUDGET_FACTOR = 30.0
 
 def accuracy_study(model, q0=None, u0=None, t_end=1.0, *, integrators=DEFAULT_INTEGRATORS,
                    tolerances=TOLERANCES, steps=None, events=(), samples=201, repeats=3,
-                   time_budget_s=20.0, method="jourdain", progress=None):
+                   time_budget_s=20.0, method="jourdain", progress=None, atol=None):
     """Run the work-precision sweep; returns a ``Study``.
 
-    ``steps``: step sizes of the fixed-step schemes (default ``default_steps``).  Runs of
+    ``steps``: step sizes of the fixed-step schemes (default ``default_steps``).  ``atol``:
+    the adaptive runs' absolute tolerance (default: each tolerance / 1000).  Runs of
     one integrator stop when a single run takes longer than ``time_budget_s``.  With
     terminal ``events`` every run is compared with the reference on the time span both
     cover.
@@ -151,7 +152,7 @@ def accuracy_study(model, q0=None, u0=None, t_end=1.0, *, integrators=DEFAULT_IN
         _warm_up(model, q0, u0, t_end, integ, settings[0], method)
         for setting in settings:
             run = _score(model, q0, u0, t_end, integ, setting, events, t_samples, ref,
-                         outputs, repeats, method, time_budget_s)
+                         outputs, repeats, method, time_budget_s, atol)
             runs.append(run)
             if progress is not None:
                 progress(run)
@@ -175,11 +176,11 @@ def _warm_up(model, q0, u0, t_end, integ, setting, method):
 
 
 def _score(model, q0, u0, t_end, integ, setting, events, t_samples, ref, outputs, repeats,
-           method, time_budget_s=20.0):
+           method, time_budget_s=20.0, atol=None):
     kwargs = dict(integrator=integ, events=events, method=method, outputs=outputs,
                   t_eval=t_samples, max_wall_time=RUN_BUDGET_FACTOR * time_budget_s)
     if integ in ADAPTIVE:
-        kwargs.update(rtol=setting, atol=setting * 1e-3)
+        kwargs.update(rtol=setting, atol=setting * 1e-3 if atol is None else atol)
     else:
         kwargs.update(dt=setting)
     walls = []

@@ -9,28 +9,23 @@ from .. import limits
 from ..errors import ModelWarning, SimulationError
 from ..io.loader import METHODS
 from ..io.results import _jsonable, summary, write_results
-from ..integrate.settings import FIXED_STEP, INTEGRATORS
-from .common import Progress, add_command, fmt, heading, load, positive
+from ..integrate.settings import FIXED_STEP
+from .common import (SIMULATION_FLAGS, Progress, add_command,
+                     add_simulation_arguments, fmt, heading, load, positive)
 
-#: options that are shorthands of --set simulation.KEY=VALUE
-FLAGS = (("simulation.t_end", "--t-end"), ("simulation.method", "--method"),
-         ("simulation.integrator", "--integrator"), ("simulation.rtol", "--rtol"),
-         ("simulation.atol", "--atol"), ("simulation.dt", "--dt"),
-         ("simulation.max_steps", "--max-steps"), ("simulation.max_samples", "--max-samples"),
-         ("simulation.max_wall_time", "--max-wall-time"))
+#: options that are shorthands of --set simulation.KEY=VALUE: the shared ones
+#: (``common.SIMULATION_FLAGS``), then run's own
+FLAGS = tuple((p, f) for p, f, _, _ in SIMULATION_FLAGS) + (
+    ("simulation.method", "--method"), ("simulation.max_steps", "--max-steps"),
+    ("simulation.max_samples", "--max-samples"),
+    ("simulation.max_wall_time", "--max-wall-time"))
 
 
 def register(subparsers):
     p = add_command(subparsers, "run", "Simulate a model file with its [simulation] "
                     "settings; options override them (after --case and --set).", run)
-    p.add_argument("--t-end", metavar="T", help="end time (s)")
+    add_simulation_arguments(p)
     p.add_argument("--method", choices=METHODS, help="formulation: " + ", ".join(METHODS))
-    p.add_argument("--integrator", choices=INTEGRATORS, metavar="NAME",
-                   help="one of " + ", ".join(INTEGRATORS) + " (euler, semi-implicit-euler "
-                        "and rk4 are fixed-step and need --dt)")
-    p.add_argument("--rtol", metavar="R", help="relative tolerance (adaptive integrators)")
-    p.add_argument("--atol", metavar="A", help="absolute tolerance (adaptive integrators)")
-    p.add_argument("--dt", metavar="H", help="step size (fixed-step integrators)")
     p.add_argument("--max-steps", metavar="N", help="step budget of the run (default "
                    f"{limits.MAX_STEPS}); see docs/reliability.md")
     p.add_argument("--max-samples", metavar="N", help="stored samples at most (default "
