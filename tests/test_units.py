@@ -88,8 +88,18 @@ def test_a_run_that_needs_millions_of_steps_for_seconds_is_warned_about():
     model = _stiff_system(1e12)
     stiff = r"looks stiff or mis-scaled -- .*Radau or BDF.*units"
     with pytest.warns(mb.ModelWarning, match=stiff), \
-            pytest.raises(mb.SimulationError, match="max_steps"):
-        mb.simulate(model, 2.0, {"x": 1e-3}, max_steps=3000)
+            pytest.raises(mb.SimulationError, match="max_wall_time"):
+        mb.simulate(model, 2.0, {"x": 1e-3}, max_steps=10 ** 9, max_wall_time=1.0)
+
+
+def test_a_run_the_step_budget_stops_says_so_once():
+    """A run that cannot finish within max_steps stops with the same remedy in its
+    message; no warning repeats it."""
+    model = _stiff_system(1e12)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", mb.ModelWarning)
+        with pytest.raises(mb.SimulationError, match="max_steps.*Radau or BDF"):
+            mb.simulate(model, 2.0, {"x": 1e-3}, max_steps=3000)
 
 
 def test_an_ordinary_run_is_not_warned_about():

@@ -105,13 +105,13 @@ def warn_stiff(budget, projected, h):
 
 def projected_over_budget(budget, steps, t, t_end, recent):
     """Stop early a run that cannot finish within ``max_steps`` at its current pace (and
-    warn about a run that looks stiff or mis-scaled: ``warn_stiff``)."""
+    warn about one that can but looks stiff or mis-scaled: ``warn_stiff``)."""
     h = float(np.median(recent))
     if not h > 1e4 * np.finfo(float).eps * abs(t):
         return None     # at the rounding limit: the integrator's own failure follows, precisely
     projected = steps + (t_end - t) / h
-    warn_stiff(budget, projected, h)
     if projected <= budget["max_steps"]:
+        warn_stiff(budget, projected, h)        # it goes on (a stop says as much itself)
         return None
     drives = budget.get("drives")
     suspects = (f"; or the drive of {', '.join(map(repr, drives))} grows without bound or "

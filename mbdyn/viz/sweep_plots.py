@@ -31,7 +31,8 @@ def plot_sweep(result, quantity, path, axes=None, title=None, ax=None):
     from ..analysis.sweeps.quantities import column_of
     if ax is None:
         files.check_target(path, FORMATS, "picture")
-    quantity = column_of(quantity)
+    if quantity not in result.columns:
+        quantity = column_of(quantity)
     if quantity not in result.columns:
         raise ModelError(f"--plot {quantity}: not a column of the table; the columns are: "
                          + ", ".join(result.columns))
