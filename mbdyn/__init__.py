@@ -19,7 +19,7 @@ _PUBLIC = {
     "Result": ".integrate.result", "Event": ".integrate.events",
     "simulate": ".integrate.simulation", "INTEGRATORS": ".integrate.settings",
     "FIXED_STEP": ".integrate.settings",
-    "t": ".elements.values",
+    "t": ".elements.values", "deg": ".elements.values",
     "ModelError": ".errors", "ModelWarning": ".errors", "NonFiniteError": ".errors",
     "SimulationError": ".errors", "SingularityWarning": ".errors",
     "SingularMassMatrixError": ".errors",
@@ -30,7 +30,7 @@ _PUBLIC = {
     "Linearization": ".analysis", "Modes": ".analysis", "Campbell": ".analysis",
     "sweep": ".analysis.sweep", "SweepResult": ".analysis.sweep",
 }
-__all__ = ["System", "Model", "Kinematics", "Result", "Event", "simulate", "inertia", "t",
+__all__ = ["System", "Model", "Kinematics", "Result", "Event", "simulate", "inertia", "t", "deg",
            "GROUND", "INTEGRATORS", "FIXED_STEP", "ModelError", "ModelWarning",
            "NonFiniteError", "SimulationError", "SingularityWarning",
            "SingularMassMatrixError", "load_model", "Scene", "ModelFileError", "derive",

@@ -8,6 +8,8 @@
   the new file where the link was; the file the link pointed at (perhaps outside the
   output folder) is left as it was.  Every output behaves so: results, pictures,
   animations, sweep tables and their plots, Campbell diagrams.
+* **Modes as the user's umask makes them** (``0666 & ~umask``: 0644 under the usual 022),
+  as ``open()`` would, not the 0600 of a temporary file.
 * **Messages name the target the user gave**, never the temporary.
 * ``check_target`` checks a target before any work: its format, that it is not a folder,
   that its folder exists and is writable.
@@ -63,10 +65,24 @@ def temporary(path, keep_extension=False):
                                    suffix=suffix, dir=directory)
     except OSError as exc:
         raise _target_error(exc, path) from None
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o666 & ~umask)
+    os.chmod(tmp, 0o666 & ~current_umask())    # mkstemp's 0600 -> what open() would give
     return fd, tmp
+
+
+def current_umask():
+    """The process's umask, read without changing it where the system tells it
+    (``/proc/self/status``: setting it to read it back would, for that instant, give a
+    file another thread creates the wrong mode); else set and restored."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    umask = os.umask(0o022)
+    os.umask(umask)
+    return umask
 
 
 def remove(path):

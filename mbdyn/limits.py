@@ -86,6 +86,13 @@ def magnitude_problem(value):
     return None
 
 
+# -- what a run is worth (``mbdyn.integrate.quality``)
+#: a run's energy balance drift (over its energy scale), its quaternions' drift off unit
+#: length, or its error estimate (over its coordinate's scale) above this is a warning
+#: that names the figure and the remedy (``mbdyn run --warn-threshold``,
+#: ``Result.quality(threshold=...)``)
+WARN_THRESHOLD = 0.01
+
 # -- work (defaults a user can raise)
 #: stored samples of one run (rows of t, q, u); beyond it give output_dt to decimate
 MAX_SAMPLES = 2_000_000

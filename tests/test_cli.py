@@ -18,7 +18,8 @@ BEAD = str(MODELS / "bead_on_rod.toml")
 SUMMARY_TYPES = {"model": str, "case": (str, type(None)), "t_final": float, "q": dict,
                  "reactions": (dict, type(None)), "drive_efforts": (dict, type(None)),
                  "points": (dict, type(None)),
-                 "u": dict, "events": list, "energy": (dict, type(None)), "stats": dict}
+                 "u": dict, "events": list, "energy": (dict, type(None)), "stats": dict,
+                 "quality": dict}
 STATS_TYPES = {"integrator": str, "method": str, "steps": int, "rhs_evaluations": int,
                "wall_time_s": float}
 
@@ -38,6 +39,9 @@ def check_run_json(d):
     if d["energy"] is not None:
         assert set(d["energy"]) == {"initial", "final"}
         assert all(isinstance(v, float) for v in d["energy"].values())
+    assert set(d["quality"]) == {"energy_drift", "quaternion_drift", "error_estimate",
+                                 "threshold", "warnings"}
+    assert all(isinstance(w, str) for w in d["quality"]["warnings"])
 
 
 def run_module(*args, timeout=300):

@@ -240,7 +240,7 @@ def test_an_interrupted_sweep_leaves_no_temporary_folder(tmp_path):
         import time
         deadline = time.monotonic() + 200
         while time.monotonic() < deadline and proc.poll() is None:
-            if table.exists() and len(table.read_text().splitlines()) >= 4:   # 2 members
+            if table.exists() and len(table.read_text().splitlines()) >= 3:   # 2 members
                 break
             time.sleep(0.05)
         assert proc.poll() is None, "the sweep ended before it could be interrupted"
@@ -371,7 +371,7 @@ def _start_sweep(tmp_path, table, members=400, extra=()):
                             text=True, cwd=tmp_path, env=env())
     deadline = time.monotonic() + 200
     while time.monotonic() < deadline and proc.poll() is None:
-        if table.exists() and len(table.read_text().splitlines()) >= 4:
+        if table.exists() and len(table.read_text().splitlines()) >= 3:    # 2 rows
             return proc
         time.sleep(0.05)
     proc.kill()
@@ -404,7 +404,8 @@ def test_a_second_sweep_on_the_same_table_is_refused(tmp_path, capsys):
         import time
         time.sleep(1.0)
         assert len(table.read_text().splitlines()) >= before  # ... its table intact
-        assert table.read_text().startswith("# mbdyn sweep table v1")
+        assert table.read_text().startswith("member,")        # a plain CSV, and
+        assert json.loads((tmp_path / "s.json").read_text())["status"] == "running"
     finally:
         _stop(first)
     assert first.returncode == 130
@@ -421,7 +422,7 @@ def test_the_lock_of_a_killed_sweep_is_taken_over(tmp_path, capsys):
     code, out, err = run_main(SWEEP + ["--out", str(table)], tmp_path, capsys)
     assert code == 0, err
     assert not (tmp_path / ".s.csv.lock").exists()
-    assert len(table.read_text().splitlines()) == 2 + 2
+    assert len(table.read_text().splitlines()) == 1 + 2
 
 
 def test_the_table_lock_refuses_a_second_holder_in_one_process(tmp_path):
@@ -438,49 +439,59 @@ def test_the_table_lock_refuses_a_second_holder_in_one_process(tmp_path):
 
 @pytest.fixture(scope="module")
 def finished_table(tmp_path_factory):
-    """The lines (bytes) of the table of ``SWEEP`` (2 members) as mbdyn writes it."""
+    """The lines (bytes) of the table of ``SWEEP`` (2 members) as mbdyn writes it (its
+    sidecar ``s.json`` is ``FINISHED_SIDECAR[0]``)."""
     from mbdyn.analysis.sweep import sweep
     folder = tmp_path_factory.mktemp("table")
     (folder / "model.toml").write_text(BASE)
     sweep(str(folder / "model.toml"), GRID, out=str(folder / "s.csv"))
+    FINISHED_SIDECAR[:] = [(folder / "s.json").read_bytes()]
     return (folder / "s.csv").read_bytes().splitlines(keepends=True)
+
+
+FINISHED_SIDECAR = []
+
+
+def _with_sidecar(folder, sidecar=None):
+    """The finished table's sidecar written into ``folder`` (or ``sidecar``'s bytes)."""
+    (folder / "s.json").write_bytes(FINISHED_SIDECAR[0] if sidecar is None else sidecar)
 
 
 def _row(lines, k, **cells):
     """``lines`` with cells of row ``k`` (0: the first member) replaced by name."""
-    header = lines[1].decode().rstrip("\n").split(",")
-    row = lines[2 + k].decode().rstrip("\n").split(",")
+    header = lines[0].decode().rstrip("\n").split(",")
+    row = lines[1 + k].decode().rstrip("\n").split(",")
     for name, value in cells.items():
         row[header.index(name)] = value
-    return lines[:2 + k] + [",".join(row).encode() + b"\n"] + lines[3 + k:]
+    return lines[:1 + k] + [",".join(row).encode() + b"\n"] + lines[2 + k:]
 
 
 #: id, the finished table's lines -> the file's bytes, pattern of the message
 RESUME_CASES = [
     ("member-text", lambda ls: _row(ls, 0, member="abc"),
-     r"s.csv: line 3: member 'abc' is not a member number of this sweep \(0 to 1\)"),
-    ("member-fraction", lambda ls: _row(ls, 1, member="1.5"), r"line 4: member '1.5'"),
-    ("member-negative", lambda ls: _row(ls, 0, member="-1"), r"line 3: member '-1'"),
-    ("member-beyond", lambda ls: _row(ls, 1, member="7"), r"line 4: member '7'"),
-    ("member-unicode-digit", lambda ls: _row(ls, 0, member="\u0661"), r"line 3: member"),
-    ("member-twice", lambda ls: _row(ls, 1, member="0"), r"line 4: member 0 appears twice"),
+     r"s.csv: line 2: member 'abc' is not a member number of this sweep \(0 to 1\)"),
+    ("member-fraction", lambda ls: _row(ls, 1, member="1.5"), r"line 3: member '1.5'"),
+    ("member-negative", lambda ls: _row(ls, 0, member="-1"), r"line 2: member '-1'"),
+    ("member-beyond", lambda ls: _row(ls, 1, member="7"), r"line 3: member '7'"),
+    ("member-unicode-digit", lambda ls: _row(ls, 0, member="\u0661"), r"line 2: member"),
+    ("member-twice", lambda ls: _row(ls, 1, member="0"), r"line 3: member 0 appears twice"),
     ("status-unknown", lambda ls: _row(ls, 0, status="maybe"),
-     r"line 3: status 'maybe' is not one of ok, failed, error"),
+     r"line 2: status 'maybe' is not one of ok, failed, error"),
     ("quantity-text", lambda ls: _row(ls, 0, t_final="abc"),
-     r"line 3: t_final holds 'abc', not a number"),
+     r"line 2: t_final holds 'abc', not a number"),
     ("override-changed", lambda ls: _row(ls, 1, **{"parameters.l": "9.0"}),
-     r"line 4: member 1's parameters.l is '9.0', the sweep's is '0.5'"),
-    ("cells-missing", lambda ls: ls[:2] + [b"0,0.4,ok\n"] + ls[3:],
-     r"line 3: has 3 cells, the table \d+ columns"),
-    ("not-utf8", lambda ls: ls[:2] + [ls[2][:-1] + b"\xff\xfe\n"] + ls[3:],
-     r"line 3: is not UTF-8 text \(invalid start byte at byte \d+\)"),
-    ("nul-byte", lambda ls: ls[:2] + [ls[2].replace(b",ok,", b",o\x00k,")] + ls[3:],
-     r"line 3: holds a NUL byte"),
-    ("line-20-mb", lambda ls: ls[:2] + [b"0,0.4,ok," + b"x" * 20_000_000 + b"\n"] + ls[3:],
-     r"line 3: is longer than 1000000 bytes"),
-    ("field-200-kb", lambda ls: _row(ls, 0, error="x" * 200_000), r"line 3: field larger"),
+     r"line 3: member 1's parameters.l is '9.0', the sweep's is '0.5'"),
+    ("cells-missing", lambda ls: ls[:1] + [b"0,0.4,ok\n"] + ls[2:],
+     r"line 2: has 3 cells, the table \d+ columns"),
+    ("not-utf8", lambda ls: ls[:1] + [ls[1][:-1] + b"\xff\xfe\n"] + ls[2:],
+     r"line 2: is not UTF-8 text \(invalid start byte at byte \d+\)"),
+    ("nul-byte", lambda ls: ls[:1] + [ls[1].replace(b",ok,", b",o\x00k,")] + ls[2:],
+     r"line 2: holds a NUL byte"),
+    ("line-20-mb", lambda ls: ls[:1] + [b"0,0.4,ok," + b"x" * 20_000_000 + b"\n"] + ls[2:],
+     r"line 2: is longer than 1000000 bytes"),
+    ("field-200-kb", lambda ls: _row(ls, 0, error="x" * 200_000), r"line 2: field larger"),
     ("binary-first-line", lambda ls: [b"\x89PNG\r\n"] + ls[1:], r"line 1: is not UTF-8"),
-    ("another-sweep", lambda ls: [b"# mbdyn sweep table v1 spec=0000\n"] + ls[1:],
+    ("another-sweep-old-format", lambda ls: [b"# mbdyn sweep table v1 spec=0000\n"] + ls,
      r"s.csv: not a table of this sweep"),
 ]
 
@@ -494,11 +505,60 @@ def test_hostile_resume_files(case_id, corrupt, pattern, finished_table, tmp_pat
     table = tmp_path / "s.csv"
     data = b"".join(corrupt(list(finished_table)))
     table.write_bytes(data)
+    _with_sidecar(tmp_path)
     code, out, err = run_main(SWEEP + ["--out", str(table), "--resume"], tmp_path, capsys)
     assert code == 1, err
     assert re.search(pattern, err), err
     assert len(err) < 1000 and len(err.strip().splitlines()) == 1
     assert table.read_bytes() == data                       # left as it was
+    assert (tmp_path / "s.json").read_bytes() == FINISHED_SIDECAR[0]
+
+
+def _another_spec(sidecar):
+    meta = json.loads(sidecar)
+    meta["spec"] = "0000"
+    return json.dumps(meta).encode()
+
+
+#: id, the finished sidecar's bytes -> the sidecar's bytes (None: none), message pattern
+SIDECAR_CASES = [
+    ("another-sweep", _another_spec, r"s.csv: not a table of this sweep"),
+    ("no-sidecar", lambda b: None, r"s.csv: has no s.json beside it"),
+    ("not-json", lambda b: b"{not json", r"s.json: is not JSON \("),
+    ("other-json", lambda b: b'{"format": "x"}', r"s.json: is not the sidecar of a sweep"),
+    ("huge", lambda b: b" " * 2_000_000, r"s.json: is longer than 1000000 bytes"),
+]
+
+
+@pytest.mark.parametrize("case_id, corrupt, pattern", SIDECAR_CASES,
+                         ids=[c[0] for c in SIDECAR_CASES])
+def test_a_table_is_resumed_only_with_its_own_sidecar(case_id, corrupt, pattern,
+                                                      finished_table, tmp_path, capsys,
+                                                      monkeypatch):
+    import mbdyn.analysis.sweep as sw
+    monkeypatch.setattr(sw, "make_scheduler", lambda *a: Refuse())   # no member may run
+    (tmp_path / "s.csv").write_bytes(b"".join(finished_table))
+    sidecar = corrupt(FINISHED_SIDECAR[0])
+    if sidecar is not None:
+        _with_sidecar(tmp_path, sidecar)
+    code, _, err = run_main(SWEEP + ["--out", "{tmp}/s.csv", "--resume"], tmp_path, capsys)
+    assert code == 1 and re.search(pattern, err), err
+    assert len(err.strip().splitlines()) == 1
+    assert (tmp_path / "s.csv").read_bytes() == b"".join(finished_table)
+
+
+def test_a_table_of_the_old_format_is_resumed_and_rewritten(finished_table, tmp_path,
+                                                            capsys):
+    """Before the sidecar, a table's first line held its fingerprint: such a table (here
+    cut after its first row) is resumed, and written in the new format."""
+    spec = json.loads(FINISHED_SIDECAR[0])["spec"]
+    old = [f"# mbdyn sweep table v1 spec={spec}\n".encode()] + finished_table[:2]
+    (tmp_path / "s.csv").write_bytes(b"".join(old))
+    code, out, err = run_main(SWEEP + ["--out", "{tmp}/s.csv", "--resume"], tmp_path, capsys)
+    assert code == 0 and "1 run now" in out, err
+    assert (tmp_path / "s.csv").read_bytes() == b"".join(finished_table)
+    meta = json.loads((tmp_path / "s.json").read_text())
+    assert meta["spec"] == spec and meta["status"] == "complete" and meta["rows"] == 2
 
 
 def test_a_resume_file_that_is_a_fifo_is_refused_not_waited_on(tmp_path, capsys):
@@ -510,7 +570,8 @@ def test_a_resume_file_that_is_a_fifo_is_refused_not_waited_on(tmp_path, capsys)
 def test_a_row_cut_by_a_kill_is_run_again_and_a_whole_table_resumes(finished_table, tmp_path,
                                                                     capsys):
     table = tmp_path / "s.csv"
-    table.write_bytes(b"".join(finished_table[:3]) + finished_table[3][:-9])   # cut row
+    table.write_bytes(b"".join(finished_table[:2]) + finished_table[2][:-9])   # cut row
+    _with_sidecar(tmp_path)
     code, out, err = run_main(SWEEP + ["--out", str(table), "--resume"], tmp_path, capsys)
     assert code == 0, err
     assert "1 run now" in out
@@ -554,7 +615,7 @@ def test_sweep_tables_hold_no_spreadsheet_formula(tmp_path, capsys):
                               text=FORMULA_MODEL)
     assert code == 0, err
     text = (tmp_path / "s.csv").read_text()
-    rows = list(csv.reader(text.splitlines()[1:]))
+    rows = list(csv.reader(text.splitlines()))
     assert _formula_cells(rows) == []
     assert "'=cmd|' /C calc'!A0" in [r[1] for r in rows]            # escaped, not lost
     statuses = [r[rows[0].index("status")] for r in rows[1:]]

@@ -322,7 +322,8 @@ def test_event_already_true_warns(tmp_path):
 SUMMARY_KEYS = {"model": str, "case": (str, type(None)), "t_final": float, "q": dict,
                  "reactions": (dict, type(None)), "drive_efforts": (dict, type(None)),
                  "points": (dict, type(None)),
-                "u": dict, "events": list, "energy": (dict, type(None)), "stats": dict}
+                "u": dict, "events": list, "energy": (dict, type(None)), "stats": dict,
+                 "quality": dict}
 STATS_KEYS = {"integrator": str, "method": str, "steps": int, "rhs_evaluations": int,
               "wall_time_s": float}
 

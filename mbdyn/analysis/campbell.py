@@ -30,6 +30,11 @@ def mac(a, b):
     return float(num / den) if den > 0 else 0.0
 
 
+#: the damping ratios the Campbell diagram's colour scale spans (beyond: its end colours);
+#: its neutral colour is at zeta = 0
+ZETA_RANGE = (-0.2, 0.5)
+
+
 @dataclass
 class Campbell:
     """``values`` of ``parameter``; per tracked mode (columns) the damped frequency
@@ -83,16 +88,20 @@ class Campbell:
 
     def plot(self, path=None, orders=(1,)):
         """Frequency against the parameter: whirl by marker (^ forward, v backward),
-        damping ratio by colour, the spin lines; saved to ``path`` (.png, .pdf, .svg) when
-        given, whole or not at all."""
+        damping ratio by colour (white at zeta = 0, red unstable, blue damped; the scale
+        ``ZETA_RANGE``), the spin lines; saved to ``path`` (.png, .pdf, .svg) when given,
+        whole or not at all."""
         from ..files import check_target
         if path is not None:
             check_target(path, (".png", ".pdf", ".svg"), "picture")
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
+        from matplotlib.colors import TwoSlopeNorm
         fig, ax = plt.subplots(figsize=(7, 4.5))
-        zeta = np.clip(self.damping_ratio, -0.2, 0.5)
+        zeta = np.clip(self.damping_ratio, ZETA_RANGE[0], ZETA_RANGE[1])
+        # neutral (white) at zeta = 0, the stability margin: red below, blue above
+        norm = TwoSlopeNorm(vmin=ZETA_RANGE[0], vcenter=0.0, vmax=ZETA_RANGE[1])
         for k in range(self.frequency.shape[1]):
             f = np.where(self.frequency[:, k] > 0, self.frequency[:, k], np.nan)
             ax.plot(self.values, f, "-", color="0.75", lw=1, zorder=1)
@@ -100,7 +109,7 @@ class Campbell:
                 sel = np.array([w[k] == tag for w in self.whirl]) & (self.frequency[:, k] > 0)
                 if sel.any():
                     sc = ax.scatter(self.values[sel], self.frequency[sel, k], c=zeta[sel, k],
-                                    cmap="coolwarm_r", vmin=-0.2, vmax=0.5, marker=marker,
+                                    cmap="coolwarm_r", norm=norm, marker=marker,
                                     s=22, zorder=2, edgecolors="k", linewidths=0.3)
         if self.spin_is_parameter:
             for o in orders:

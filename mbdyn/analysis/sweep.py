@@ -45,7 +45,7 @@ from .sweeps.checks import check_arguments, model_path, table_header, table_path
 from .sweeps.grid import expand, parse_grid, parse_range
 from .sweeps.member import run_member
 from .sweeps.model_file import model_text
-from .sweeps.progress import ANNOUNCE_AFTER, ESTIMATE_FROM
+from .sweeps.progress import ANNOUNCE_AFTER, ESTIMATE_FROM, Callback, tqdm_bar
 from .sweeps.progress import Progress as _Progress
 from .sweeps.quantities import DEFAULT_QUANTITIES, SIMPLE, STATS, columns, measure
 from .sweeps.resume import read_done, read_table
@@ -100,11 +100,15 @@ def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, f
     ``"processes"``, ``"dask"``, ``"tcp://HOST:PORT"`` or a scheduler object
     (``schedulers``); ``workers``: local worker count.  ``out``: the CSV to write as
     members finish (``.parquet`` too if the name ends so and pyarrow is present), locked
-    against a second sweep meanwhile; ``resume``: keep the finished rows of ``out`` and
+    against a second sweep meanwhile, with its sidecar ``NAME.json`` (the sweep's
+    fingerprint, model, quantities, columns, status); ``resume``: keep the finished rows
+    of ``out`` and
     run only the rest.  ``batched``: advance members that share one compiled model in one
     compiled call (fixed-step schemes only; see ``batchable``), ``batch_size`` members per
-    task.  ``progress``: a counter on stderr (default: when stderr is a terminal; a long
-    sweep is announced with an estimate of its duration either way; False: nothing).
+    task.  ``progress``: ``True`` a progress bar on stderr (tqdm's if installed, else a
+    counter line), a function ``progress(done, total)`` called after each member,
+    ``False`` nothing, ``None`` (default) the counter when stderr is a terminal; a long
+    sweep is announced with an estimate of its duration unless it is ``False``.
     ``require_columns``: columns the caller will need (e.g. to plot), checked up front.
     ``scheduler_timeout``: the longest wait, in seconds, on a Dask scheduler at an address
     (connection, handshake, each result, each check that it still answers; default
@@ -116,7 +120,7 @@ def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, f
     """
     path, cases = model_path(model, cases)
     check_arguments(scheduler, quantities, cases, fixed, workers, batch_size, out, resume,
-                    require_columns, scheduler_timeout)
+                    require_columns, scheduler_timeout, progress)
     text = model_text(path)
     members = expand(overrides, cases)
     quantities = tuple(quantities)
@@ -130,7 +134,9 @@ def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, f
             "quantities": list(quantities)}
     csv_path = table_path(out)
     lock = files.TableLock(csv_path) if csv_path else None
-    table = Table(csv_path, head, spec) if csv_path else None
+    meta = {"model": str(path), "members": len(members), "quantities": list(quantities),
+            "fixed": dict(fixed or {}), "cases": None if cases is None else list(cases)}
+    table = Table(csv_path, head, spec, meta) if csv_path else None
     try:
         if lock is not None:
             lock.acquire()
@@ -165,8 +171,8 @@ def sweep(model, overrides=None, quantities=DEFAULT_QUANTITIES, *, cases=None, f
 
 
 def _fingerprint(text, members, fixed_list, quantities):
-    """The sweep's fingerprint in its table's first line: a resume is refused unless the
-    model, members, fixed overrides and quantities are the same."""
+    """The sweep's fingerprint in its table's sidecar JSON: a resume is refused unless
+    the model, members, fixed overrides and quantities are the same."""
     return hashlib.sha256(json.dumps([text, members, fixed_list, list(quantities)],
                                      default=repr).encode()).hexdigest()[:20]
 
@@ -179,10 +185,20 @@ def _kept_rows(table, resume, members):
 
 
 def _progress(total, kept, progress):
-    """The sweep's ``_Progress`` (None for ``progress=False``: nothing on stderr); its
-    counter shown for ``progress=True``, or by default when stderr is a terminal."""
+    """What the sweep shows as members finish: nothing for ``progress=False``; for
+    ``True`` a progress bar on stderr (tqdm's if tqdm is installed, else ``_Progress``'s
+    counter line); a function ``progress(done, total)`` called after each member; by
+    default (``None``) the counter when stderr is a terminal.  A long sweep is announced
+    with an estimate of its duration unless ``progress`` is ``False``, a function or
+    tqdm's bar (which shows its own)."""
     if progress is False:
         return None
+    if callable(progress):
+        return Callback(progress, total, kept)
+    if progress is True:
+        bar = tqdm_bar(total, kept)
+        if bar is not None:
+            return bar
     counter = bool(progress) if progress is not None else bool(
         getattr(sys.stderr, "isatty", lambda: False)())
     return _Progress(total, kept, counter, announce_after=ANNOUNCE_AFTER,

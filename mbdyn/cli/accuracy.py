@@ -10,7 +10,7 @@ from ..errors import ModelError
 from ..escape import legend_label, mathtext
 from ..files import check_target, replacing
 from ..integrate.settings import INTEGRATORS
-from .common import add_command, load, positive, positive_int
+from .common import add_command, add_simulation_arguments, load, positive, positive_int
 
 
 def register(subparsers):
@@ -19,8 +19,9 @@ def register(subparsers):
                     "Radau), then with each integrator over a sweep of tolerances (adaptive) "
                     "or step sizes (fixed-step); report error (max over time), energy drift, "
                     "wall time and right-hand-side evaluations.", run)
-    p.add_argument("--t-end", metavar="T", type=positive,
-                   help="end time (s; default the file's simulation.t_end)")
+    add_simulation_arguments(p, "of the study: --integrator X is --integrators X, --rtol R "
+                                "--tolerances R (each with atol R/1000 unless --atol), --dt H "
+                                "--steps H")
     p.add_argument("--integrators", metavar="LIST",
                    help="comma-separated, from " + ", ".join(INTEGRATORS)
                         + f" (default {','.join(DEFAULT_INTEGRATORS)})")
@@ -51,27 +52,46 @@ def _floats(text, what):
     return values
 
 
+def _one_or_many(args, one, many):
+    """The value of the option ``one`` (a shared simulation flag) or ``many`` (the study's
+    list), not both."""
+    a, b = getattr(args, one.lstrip("-")), getattr(args, many.lstrip("-"))
+    if a is not None and b is not None:
+        raise ModelError(f"{one} and {many}: give one of the two ({one} X is {many} X)")
+    return a if a is not None else b
+
+
+def _settings(args):
+    """``(integrators, tolerances, steps, atol)`` of the study from its options."""
+    integrators = DEFAULT_INTEGRATORS
+    names = _one_or_many(args, "--integrator", "--integrators")
+    if names:
+        integrators = tuple(x.strip() for x in names.split(",") if x.strip())
+        unknown = [x for x in integrators if x not in INTEGRATORS]
+        if unknown:
+            raise ModelError(f"--integrators: unknown {', '.join(unknown)}; choose from "
+                             f"{', '.join(INTEGRATORS)}")
+    tolerances = _one_or_many(args, "--rtol", "--tolerances")
+    tolerances = _floats(tolerances, "tolerances") if tolerances else TOLERANCES
+    steps = _one_or_many(args, "--dt", "--steps")
+    steps = _floats(steps, "steps") if steps else None
+    atol = _floats(args.atol, "atol")[0] if args.atol else None
+    return integrators, tolerances, steps, atol
+
+
 def run(args):
     if args.plot:                      # before the study: a bad path costs nothing
         check_target(args.plot, (".png", ".pdf", ".svg"), "picture", "--plot")
         _require_matplotlib()
-    scene = load(args)
-    t_end = args.t_end if args.t_end is not None else scene.settings.get("t_end")
+    scene = load(args, [("simulation.t_end", "--t-end")])   # the others choose the runs
+    t_end = scene.settings.get("t_end")
     if not t_end:
         raise ModelError(f"{scene.path}: simulation.t_end is not set; pass --t-end T")
     if not (math.isfinite(t_end) and t_end > 0):
         raise ModelError(f"--t-end {t_end}: give a positive, finite end time")
     if not (math.isfinite(args.budget) and args.budget > 0):
         raise ModelError(f"--budget {args.budget}: give a positive number of seconds")
-    integrators = DEFAULT_INTEGRATORS
-    if args.integrators:
-        integrators = tuple(x.strip() for x in args.integrators.split(",") if x.strip())
-        unknown = [x for x in integrators if x not in INTEGRATORS]
-        if unknown:
-            raise ModelError(f"--integrators: unknown {', '.join(unknown)}; choose from "
-                             f"{', '.join(INTEGRATORS)}")
-    tolerances = _floats(args.tolerances, "tolerances") if args.tolerances else TOLERANCES
-    steps = _floats(args.steps, "steps") if args.steps else None
+    integrators, tolerances, steps, atol = _settings(args)
 
     def progress(run):
         if not args.json and sys.stderr.isatty():
@@ -81,7 +101,8 @@ def run(args):
                            integrators=integrators, tolerances=tolerances, steps=steps,
                            events=scene.events, repeats=max(1, args.repeats),
                            time_budget_s=args.budget,
-                           method=scene.settings.get("method", "jourdain"), progress=progress)
+                           method=scene.settings.get("method", "jourdain"), progress=progress,
+                           atol=atol)
     if not args.json and sys.stderr.isatty():
         sys.stderr.write("\n")
     if args.plot:

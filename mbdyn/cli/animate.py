@@ -1,6 +1,7 @@
 """``mbdyn animate MODEL --out FILE.gif|.mp4|.html``: simulate and animate.
 
     mbdyn animate MODEL [--case NAME] [--set PATH=VALUE ...] [--effects LIST]
+                        [--t-end T] [--integrator NAME] [--rtol R] [--atol A] [--dt H]
                         [--out FILE] [--speed S] [--fps F]
 """
 from __future__ import annotations
@@ -8,7 +9,15 @@ from __future__ import annotations
 import os
 import sys
 
-from .common import Progress, add_command, default_output, load, positive, title
+from .common import (
+    Progress,
+    add_command,
+    add_simulation_arguments,
+    default_output,
+    load,
+    positive,
+    title,
+)
 
 
 def register(subparsers):
@@ -23,6 +32,7 @@ def register(subparsers):
     p.add_argument("--speed", type=positive, default=1.0, help="playback speed (default 1: "
                                                             "real time)")
     p.add_argument("--fps", type=positive, default=30.0, help="frames per second (default 30)")
+    add_simulation_arguments(p)
 
 
 def run(args):

@@ -72,10 +72,42 @@ def add_model_arguments(parser):
                              "gyroscopic, every load and force element (mbdyn info lists them)")
 
 
-def overrides(args, flags=()):
-    """``--set`` texts, then the ``(path, flag)`` options given (e.g. ``--dt``), as
-    ``(path, value, origin)`` triples for ``load_model``."""
-    out = list(args.overrides)
+#: the simulation options of every command that runs a model (run, plot, animate, sweep,
+#: accuracy), defined once: ``(dotted path, flag, metavar, help)``; each is a shorthand of
+#: ``--set PATH=VALUE`` applied after ``--case`` and ``--set`` (a number or an expression)
+SIMULATION_FLAGS = (
+    ("simulation.t_end", "--t-end", "T", "end time (s)"),
+    ("simulation.integrator", "--integrator", "NAME", None),
+    ("simulation.rtol", "--rtol", "R", "relative tolerance (adaptive integrators)"),
+    ("simulation.atol", "--atol", "A", "absolute tolerance (adaptive integrators)"),
+    ("simulation.dt", "--dt", "H", "step size (fixed-step integrators)"),
+)
+
+
+def add_simulation_arguments(parser, what="overrides the file's [simulation]"):
+    """``--t-end --integrator --rtol --atol --dt`` (``SIMULATION_FLAGS``); their values
+    are read as ``--set`` values (``overrides``, ``simulation_overrides``)."""
+    from ..integrate.settings import FIXED_STEP, INTEGRATORS
+    for _, flag, metavar, text in SIMULATION_FLAGS:
+        if flag == "--integrator":
+            parser.add_argument(flag, choices=INTEGRATORS, metavar=metavar,
+                                help=f"one of {', '.join(INTEGRATORS)} ({', '.join(FIXED_STEP)}"
+                                     f" are fixed-step and need --dt); {what}")
+        else:
+            parser.add_argument(flag, metavar=metavar, help=f"{text}; {what}")
+
+
+def simulation_overrides(args):
+    """``{dotted path: value}`` of the ``SIMULATION_FLAGS`` given (for ``sweep``'s fixed
+    overrides)."""
+    return {path: value for path, value, _ in _flag_values(
+        args, [(p, f) for p, f, _, _ in SIMULATION_FLAGS])}
+
+
+def _flag_values(args, flags):
+    """``(path, value, origin)`` of each ``(path, flag)`` option given, its text read as
+    a ``--set`` value."""
+    out = []
     for path, flag in flags:
         value = getattr(args, flag.lstrip("-").replace("-", "_"), None)
         if value is None:
@@ -88,8 +120,19 @@ def overrides(args, flags=()):
     return out
 
 
-def load(args, flags=(), record_warnings=False):
-    """The ``Scene`` of the command line's model, case and overrides."""
+def overrides(args, flags=()):
+    """``--set`` texts, then the ``(path, flag)`` options given (e.g. ``--dt``), as
+    ``(path, value, origin)`` triples for ``load_model``."""
+    return list(args.overrides) + _flag_values(args, flags)
+
+
+def load(args, flags=None, record_warnings=False):
+    """The ``Scene`` of the command line's model, case and overrides (``flags``: the
+    ``(path, flag)`` options to apply; default the ``SIMULATION_FLAGS`` the command
+    has)."""
+    if flags is None:
+        flags = [(p, f) for p, f, _, _ in SIMULATION_FLAGS
+                 if hasattr(args, f.lstrip("-").replace("-", "_"))]
     effects = getattr(args, "effects", None)
     if record_warnings:
         with warnings.catch_warnings(record=True):

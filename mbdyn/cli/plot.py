@@ -1,13 +1,21 @@
 """``mbdyn plot MODEL``: simulate and plot time series or a phase portrait.
 
     mbdyn plot MODEL [--case NAME] [--set PATH=VALUE ...] [--effects LIST]
+                     [--t-end T] [--integrator NAME] [--rtol R] [--atol A] [--dt H]
                      [--series NAMES] [--phase X,Y] [--out FILE.png|.pdf|.svg]
 """
 from __future__ import annotations
 
 import sys
 
-from .common import Progress, add_command, default_output, load, title
+from .common import (
+    Progress,
+    add_command,
+    add_simulation_arguments,
+    default_output,
+    load,
+    title,
+)
 
 
 def register(subparsers):
@@ -19,6 +27,7 @@ def register(subparsers):
                    help="comma-separated: " + SERIES_HELP + " (default: the coordinates and "
                         "the energies when the file asks for them)")
     p.add_argument("--phase", metavar="X,Y", help="a phase portrait of two series")
+    add_simulation_arguments(p)
     p.add_argument("--out", metavar="FILE", help="picture file: .png, .pdf or .svg (default "
                                                  "STEM.png in the current directory)")
 

@@ -13,12 +13,20 @@ import sys
 from .. import limits
 from ..analysis.schedulers import check_spec
 from ..analysis.sweep import DEFAULT_QUANTITIES, parse_grid, sweep
+from ..analysis.sweeps.quantities import column_of
 from ..errors import ModelError
 from ..escape import spreadsheet_cell
 from ..files import check_target
 from ..io.schema import parse_set_value
 from ..viz.sweep_plots import FORMATS as PICTURES
-from .common import add_command, fmt, positive, positive_int
+from .common import (
+    add_command,
+    add_simulation_arguments,
+    fmt,
+    positive,
+    positive_int,
+    simulation_overrides,
+)
 
 
 def register(subparsers):
@@ -35,6 +43,7 @@ def register(subparsers):
                    help="case(s) to run (repeatable: an outer loop); default the file's")
     p.add_argument("--set", dest="fixed", metavar="PATH=VALUE", action="append", default=[],
                    help="override for every member, e.g. simulation.integrator=rk4")
+    add_simulation_arguments(p, "for every member, after --set")
     p.add_argument("--quantity", "-q", dest="quantities", metavar="Q", action="append",
                    help="what to keep per member: final, events, t_final, energy_drift, "
                         "steps, rhs_evaluations, max:X, min:X, absmax:X, mean:X, std:X "
@@ -53,7 +62,8 @@ def register(subparsers):
     p.add_argument("--resume", action="store_true",
                    help="keep the finished rows of --out and run only the rest")
     p.add_argument("--plot", metavar="QUANTITY",
-                   help="a line (one grid axis) or heat map (two) of a table column; "
+                   help="a line (one grid axis) or heat map (two) of a table column, named "
+                        "as in the table (absmax.theta) or as -q took it (absmax:theta); "
                         "written beside --out as .png (or to --plot-file)")
     p.add_argument("--plot-file", metavar="PNG", help="where --plot writes")
     p.add_argument("--json", action="store_true",
@@ -112,13 +122,15 @@ def run(args):
         raise ModelError("give at least one --grid PATH=VALUES (e.g. "
                          "--grid parameters.Mz=-0.03:-0.001:8)")
     grid = parse_grid(args.grid)
+    args.plot = column_of(args.plot) if args.plot else None      # -q absmax:X -> absmax.X
     plot_file = args.plot_file or (args.out.rsplit(".", 1)[0] + f"_{args.plot}.png"
                                    if args.plot and args.out else None)
     if args.plot and not plot_file:
         raise ModelError("--plot needs --out FILE or --plot-file PNG")
     _check_outputs(args.out, plot_file)
     result = sweep(args.model, grid, tuple(args.quantities or DEFAULT_QUANTITIES),
-                   cases=args.case, fixed=_fixed(args.fixed), scheduler=args.scheduler,
+                   cases=args.case, fixed={**_fixed(args.fixed), **simulation_overrides(args)},
+                   scheduler=args.scheduler,
                    workers=args.workers, out=args.out, resume=args.resume,
                    batched=args.batched, progress=None,
                    require_columns=[args.plot] if args.plot else [],

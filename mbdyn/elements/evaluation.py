@@ -26,6 +26,7 @@ FLOAT_FUNCTIONS = {
     "tanh": math.tanh, "sqrt": math.sqrt, "exp": math.exp,
     "log": lambda x, b=None: math.log(x) if b is None else math.log(x, b),
     "abs": abs, "sign": lambda x: math.copysign(1.0, x) if x else 0.0, "min": min, "max": max,
+    "deg": math.radians,
 }
 
 

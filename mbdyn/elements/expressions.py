@@ -23,6 +23,11 @@ from .evaluation import (FLOAT_FUNCTIONS, ExpressionError, _float_call, _float_p
                          to_float)
 from .expansion import ObjectMemo, expanded_terms  # noqa: F401  (their old import path)
 
+def degrees_to_radians(x):
+    """``deg(x)``: ``x`` degrees in radians, ``x*pi/180`` (exact: ``deg(90)`` is ``pi/2``)."""
+    return x * sympy.pi / 180
+
+
 #: Functions an expression may call: name -> (sympy function, allowed numbers of arguments).
 FUNCTIONS = {
     "sin": (sympy.sin, (1,)), "cos": (sympy.cos, (1,)), "tan": (sympy.tan, (1,)),
@@ -32,6 +37,7 @@ FUNCTIONS = {
     "sqrt": (sympy.sqrt, (1,)), "exp": (sympy.exp, (1,)), "log": (sympy.log, (1, 2)),
     "abs": (sympy.Abs, (1,)), "sign": (sympy.sign, (1,)),
     "min": (sympy.Min, (2, 3, 4, 5, 6, 7, 8)), "max": (sympy.Max, (2, 3, 4, 5, 6, 7, 8)),
+    "deg": (degrees_to_radians, (1,)),
 }
 #: Named constants.
 CONSTANTS = {"pi": sympy.pi}

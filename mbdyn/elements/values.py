@@ -15,6 +15,20 @@ from ..errors import ModelError
 t = sympy.Symbol("t", real=True)
 
 
+def deg(x):
+    """``x`` degrees in radians (``mb.deg(30)``, ``q0={"theta": mb.deg(45)}``), as
+    ``deg(...)`` in model-file expressions: a float for a number, an array for an array,
+    ``x*pi/180`` for a sympy expression (``drive=mb.deg(10) * mb.t`` stays exact)."""
+    if isinstance(x, sympy.Basic):
+        return x * sympy.pi / 180
+    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, float, np.number, list,
+                                                             tuple, np.ndarray)):
+        raise ModelError(f"deg: give a number of degrees, got {x!r}")
+    if isinstance(x, (list, tuple, np.ndarray)):
+        return np.deg2rad(np.asarray(x, dtype=float))
+    return math.radians(x)
+
+
 AXIS_NAMES = {"x": 0, "y": 1, "z": 2}
 
 

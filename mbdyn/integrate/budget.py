@@ -6,11 +6,12 @@ the reason.
 from __future__ import annotations
 
 import time as _time
+import warnings
 
 import numpy as np
 
 from .. import limits
-from ..errors import (ModelError)
+from ..errors import ModelError, ModelWarning
 
 
 def make_budget(max_steps, max_samples, max_wall_time, decimate):
@@ -80,13 +81,37 @@ def over_budget(budget, steps, stored, t, t_end, h=None):
 PROJECTION_STEPS = 1000
 
 
+#: an adaptive run that at its pace needs more than ``STIFF_STEPS`` steps for at most
+#: ``STIFF_SPAN`` seconds of a model of at most ``STIFF_SPEEDS`` speeds is warned about
+#: once: it looks stiff or mis-scaled (lengths in mm, stiffnesses in N/mm ...)
+STIFF_STEPS = 1_000_000
+STIFF_SPAN = 10.0
+STIFF_SPEEDS = 12
+
+
+def warn_stiff(budget, projected, h):
+    """The warning of a run that looks stiff or mis-scaled (``STIFF_STEPS``), once."""
+    speeds, span = budget.get("speeds"), budget.get("span")
+    if (budget.get("stiff_warned") or speeds is None or projected <= STIFF_STEPS
+            or span > STIFF_SPAN or speeds > STIFF_SPEEDS):
+        return
+    budget["stiff_warned"] = True
+    warnings.warn(f"at its current pace (median step {h:.3g} s) the run needs about "
+                  f"{projected:.2g} steps for {span:g} s of a model with {speeds} speeds: "
+                  f"it looks stiff or mis-scaled -- {slow_pace_hint(budget)} (lengths in mm "
+                  "or stiffnesses in N/mm where SI is meant make a model stiff)", ModelWarning,
+                  stacklevel=2)
+
+
 def projected_over_budget(budget, steps, t, t_end, recent):
-    """Stop early a run that cannot finish within ``max_steps`` at its current pace."""
+    """Stop early a run that cannot finish within ``max_steps`` at its current pace (and
+    warn about one that can but looks stiff or mis-scaled: ``warn_stiff``)."""
     h = float(np.median(recent))
     if not h > 1e4 * np.finfo(float).eps * abs(t):
         return None     # at the rounding limit: the integrator's own failure follows, precisely
     projected = steps + (t_end - t) / h
     if projected <= budget["max_steps"]:
+        warn_stiff(budget, projected, h)        # it goes on (a stop says as much itself)
         return None
     drives = budget.get("drives")
     suspects = (f"; or the drive of {', '.join(map(repr, drives))} grows without bound or "

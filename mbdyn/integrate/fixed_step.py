@@ -2,14 +2,15 @@
 compiled stretches (``kernels.integrators``) where the model allows, else one Python step
 at a time (``python_steps``).  After each stretch, on whole arrays: the singularity
 monitor, the events (crossings located by linear interpolation between the two steps
-that bracket them), the samples kept, the budgets.  Steps are of size ``dt``, the last one
-shortened to end at ``t_end``; quaternions are projected after every step.
+that bracket them), the samples kept (``samples``: output times by cubic Hermite
+interpolation), the budgets.  Steps are of size ``dt``, the last one shortened to end at
+``t_end`` (``step_plan``); quaternions are projected after every step.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from ..errors import NonFiniteError, SingularMassMatrixError
+from ..errors import ModelError, NonFiniteError, SingularMassMatrixError
 from . import budget as budgets
 from .event_search import crossed_rows, event_rows, event_values
 from .events import EventRecord
@@ -28,13 +29,13 @@ def run(plan, compiled):
     g_old = event_values(plan.events, model, t, y) if plan.events else None
     found, failure, steps, stop = [], None, 0, False
     chunks = (compiled_chunks(plan, g_old) if compiled else python_chunks(plan))
-    for times, states, chunk_failure, G in chunks:
+    for times, states, chunk_failure, G, rates in chunks:
         if plan.events:
             processed, failure, stop, g_old = stretch_events(
                 plan.events, model, plan.monitor, t, y, g_old, times, states, found, G)
         else:
             processed, failure = plan.monitor.check_rows(times, states)
-        kept.add(times[:processed], states[:processed])
+        kept.add(times[:processed], states[:processed], rates[:processed])
         steps += processed
         if processed:
             t, y = times[processed - 1], states[processed - 1]
@@ -47,7 +48,7 @@ def run(plan, compiled):
             failure = budgets.over_budget(budget, steps, kept.count, t, plan.t_end)
             if failure:
                 break
-    ts, ys = kept.arrays()
+    ts, ys = kept.arrays(lambda t, y: _rate_or_none(plan.rhs, t, y))
     if not len(ts):                     # t_eval entirely beyond a failure or an event
         ts, ys = np.array([t]), y[None, :]
     info = {"steps": steps, "compiled_loop": bool(compiled)}
@@ -58,22 +59,43 @@ def run(plan, compiled):
     return Outcome(ts, ys, found, info)
 
 
-def step_times(t0, t_end, dt):
-    """The steps as ``[(h, end times), ...]``: steps of ``dt``, then, if ``t_end`` is not
-    reached within rounding, one shorter step that ends there."""
-    n_full = int(np.floor((t_end - t0) / dt * (1 + 1e-12)))
+def _rate_or_none(rhs, t, y):
+    """``y'`` at ``(t, y)``, or ``None`` where it is not finite (a run that failed there)."""
+    try:
+        return rhs(t, y)
+    except (ArithmeticError, ModelError):
+        return None
+
+
+def step_plan(t0, t_end, dt):
+    """``(end times of the full steps, h_last)``: as many steps of ``dt`` as fit (within
+    rounding), then, unless they reach ``t_end``, one shorter step ``h_last`` that ends
+    there (else ``h_last = 0``).  Steps of ``dt`` are kept as given rather than evened out
+    (a listing's step runs as the listing's); when they reach ``t_end`` within rounding --
+    44,000 steps of 4/44000 end at 3.9999999999999996 -- the last one's time is put on
+    ``t_end`` exactly, so that the run ends there and an output time ``t_end`` is kept."""
+    ratio = (t_end - t0) / dt
+    n_full = int(np.floor(ratio * (1 + 1e-12)))
     times = t0 + dt * np.arange(1, n_full + 1)
-    if n_full and times[-1] > t_end:
+    if n_full and ratio - n_full <= 1e-12 * max(1.0, ratio):
         times[-1] = t_end
-    steps = [(dt, times)]
-    if t_end - (times[-1] if n_full else t0) > 1e-12 * max(1.0, abs(t_end)):
-        steps.append((t_end - (times[-1] if n_full else t0), np.array([t_end])))
+        return times, 0.0
+    return times, t_end - (times[-1] if n_full else t0)
+
+
+def step_times(t0, t_end, dt):
+    """The steps as ``[(h, end times), ...]`` (``step_plan``)."""
+    times, h_last = step_plan(t0, t_end, dt)
+    steps = [(dt, times)] if len(times) else []
+    if h_last:
+        steps.append((h_last, np.array([t_end])))
     return steps
 
 
 def compiled_chunks(plan, g_old=None):
-    """Yield ``(times, states, failure, G)`` stretches of the motion from the compiled
-    loops.  ``G``: the event conditions at the stretch's rows when the loop evaluated them
+    """Yield ``(times, states, failure, G, rates)`` stretches of the motion from the
+    compiled loops (``rates[k]``: ``y'`` at the state before row ``k`` when the run has
+    output times, for their dense output).  ``G``: the event conditions at the stretch's rows when the loop evaluated them
     (their programs, ``compiled.programs.EventPrograms``; ``g_old`` at ``y0``), else
     ``None``; such a loop stops after a step where a terminal event occurred or a
     condition is not finite, and so does the motion."""
@@ -96,10 +118,11 @@ def compiled_chunks(plan, g_old=None):
             stage_times = (starts[:, None] + h * np.array(STAGES)[None, :]).reshape(-1)
             table = model.drive_values(stage_times).reshape(len(tk), len(STAGES), -1, 3)
             out = np.empty((len(tk) + 1, y.size))
+            rates = np.empty((len(tk) if plan.t_eval is not None else 0, y.size))
             nfev = np.zeros(1, np.int64)
             if conditions is not None:
                 checks = conditions.arguments(g_old, len(tk), False)
-            done, status = loop(h, y, table, *args, out, nfev, tk, checks)
+            done, status = loop(h, y, table, *args, out, rates, nfev, tk, checks)
             rhs.evaluations += int(nfev[0])
             failure = None
             if status:
@@ -109,24 +132,24 @@ def compiled_chunks(plan, g_old=None):
             G = None
             if conditions is not None:
                 G, g_old = checks[6][:done], checks[5]
-            yield tk[:done], out[1:done + 1], failure, G
+            yield tk[:done], out[1:done + 1], failure, G, rates[:done]
             if status or done < len(tk):
                 return
             t, y = tk[-1], out[-1].copy()
 
 
 def python_chunks(plan):
-    """Yield ``(times, states, failure, None)``, one step at a time, in Python (models
-    with loads given as Python functions, or ``compiled_loop=False``)."""
+    """Yield ``(times, states, failure, None, rates)``, one step at a time, in Python
+    (models with loads given as Python functions, or ``compiled_loop=False``)."""
     model, nq = plan.model, plan.model.nq
     t, y = plan.t0, plan.y0.copy()
     for h, ts in step_times(plan.t0, plan.t_end, plan.dt):
         for t_new in ts:
             try:
-                y_new = fixed_step(plan.rhs, plan.integrator, t, y, h, nq)
+                y_new, rate = fixed_step(plan.rhs, plan.integrator, t, y, h, nq)
             except (NonFiniteError, SingularMassMatrixError) as exc:
                 yield (np.empty(0), np.empty((0, y.size)), describe_failure(model, exc, t, y),
-                       None)
+                       None, np.empty((0, y.size)))
                 return
             model.normalize_quaternions(y_new[:nq])
             if not np.all(np.isfinite(y_new)):
@@ -134,9 +157,9 @@ def python_chunks(plan):
                        if not np.isfinite(v)]
                 yield np.empty(0), np.empty((0, y.size)), describe_failure(
                     model, NonFiniteError(f"the state became non-finite in {', '.join(bad)}"),
-                    t, y), None
+                    t, y), None, np.empty((0, y.size))
                 return
-            yield np.array([t_new]), y_new[None, :], None, None
+            yield np.array([t_new]), y_new[None, :], None, None, rate[None, :]
             t, y = t_new, y_new
 
 

@@ -11,30 +11,35 @@ from ..errors import (NonFiniteError)
 
 
 def fixed_step(rhs, integrator, t, y, h, nq):
-    """One step of a fixed-step scheme in Python (models with callable loads)."""
+    """One step of a fixed-step scheme in Python (models with callable loads): ``(the
+    state after it, y' at its start)`` (the latter for the dense output, ``samples``)."""
     model = rhs.model
     if integrator == "euler":
-        return y + h * rhs(t, y)
+        f0 = rhs(t, y)
+        return y + h * f0, f0
     if integrator == "semi-implicit-euler":
         q, u = y[:nq], y[nq:]
         rhs.evaluations += 1
-        u_new = u + h * rhs.accelerations(q, u, t)
+        ud = rhs.accelerations(q, u, t)
+        u_new = u + h * ud
         q_new = q + h * model.coordinate_rates(q, u_new)
-        return np.concatenate([q_new, u_new])
+        return np.concatenate([q_new, u_new]), np.concatenate([model.coordinate_rates(q, u),
+                                                               ud])
     if integrator == "implicit-midpoint":
-        return implicit_midpoint(rhs, t, y, h)
+        f0 = rhs(t, y)
+        return implicit_midpoint(rhs, t, y, h, f0), f0
     k1 = rhs(t, y)
     k2 = rhs(t + h / 2, y + h / 2 * k1)
     k3 = rhs(t + h / 2, y + h / 2 * k2)
     k4 = rhs(t + h, y + h * k3)
-    return y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4), k1
 
 
-def implicit_midpoint(rhs, t, y, h):
+def implicit_midpoint(rhs, t, y, h, f0):
     """``y1 = y + h F(t + h/2, (y + y1)/2)`` by Newton with a finite-difference Jacobian
-    (the same algorithm as the compiled ``implicit_midpoint_step``)."""
+    (the same algorithm as the compiled ``implicit_midpoint_step``); ``f0 = F(t, y)``."""
     tm = t + h / 2
-    ym = y + h / 2 * rhs(t, y)
+    ym = y + h / 2 * f0
     fm = rhs(tm, ym)
     y1 = y + h * fm
     n = y.size

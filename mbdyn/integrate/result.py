@@ -8,6 +8,7 @@ import numpy as np
 
 from ..errors import ModelError
 from .balance import energy_balance
+from .quality import assess
 from .settings import OUTPUTS
 
 
@@ -103,6 +104,13 @@ class Result:
             return self.points[name]
         raise KeyError(f"{name!r} is neither a coordinate ({', '.join(self.coordinates)}) nor a "
                        f"speed ({', '.join(self.speeds)}) of model {self.model.name!r}")
+
+    def quality(self, threshold=None):
+        """What the run is worth: its energy balance drift, quaternion drift and error
+        estimate (``simulate(error_estimate=True)``), with a warning sentence for each
+        above ``threshold`` (default ``mbdyn.limits.WARN_THRESHOLD``); see
+        ``mbdyn.integrate.quality.assess``."""
+        return assess(self, threshold)
 
     def plot(self, series=None, phase=None, out=None, title=None):
         """Time series or a phase portrait of this result: see ``mbdyn.viz.plot_result``

@@ -33,7 +33,8 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
              rtol=DEFAULTS["rtol"], atol=DEFAULTS["atol"], dt=None, method=DEFAULTS["method"],
              events=(), t_eval=None, max_step=np.inf, outputs=(), points=None, progress=None,
              singularity_threshold=1e-3, reactions_frame="world", compiled_loop=True,
-             decimate=1, max_steps=None, max_samples=None, max_wall_time=None):
+             decimate=1, max_steps=None, max_samples=None, max_wall_time=None,
+             error_estimate=False):
     """Integrate ``model`` (a compiled ``Model``, or a ``System`` to compile) from ``t0``
     to ``t_end``.
 
@@ -57,7 +58,8 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     DOP853, drives that ``mbdyn.compiled.programs`` translates); ``False`` forces the Python loop
     (scipy's solvers for RK45 and DOP853, which ``"scipy-RK45"`` and ``"scipy-DOP853"``
     also name).
-    ``decimate``: fixed-step schemes store every ``decimate``-th step (and the last).
+    ``decimate``: fixed-step schemes store every ``decimate``-th step (and the last); they
+    end on ``t_end`` exactly and interpolate ``t_eval`` between steps by cubic Hermite.
 
     Budgets (``mbdyn.limits``; ``docs/reliability.md``): ``max_steps`` integrator steps
     (default ``MAX_STEPS``), ``max_samples`` stored samples (default ``MAX_SAMPLES``;
@@ -67,7 +69,9 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
 
     Statistics include the mass matrix's condition number at the start and the end (a
     ``SingularityWarning`` when it is large), the largest quaternion drift and, with
-    ``outputs=("energy",)``, the energy drift.
+    ``outputs=("energy",)``, the energy drift.  ``error_estimate``: run again at half the
+    step (fixed-step) or at rtol/100, atol/100 (adaptive); ``stats["error_estimate"]``
+    holds the difference per coordinate and speed (``quality.estimate_error``).
 
     Raises ``SimulationError`` (its ``result`` holds the motion up to the failure) when
     the integrator fails or NaN/Inf appears.
@@ -80,11 +84,11 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     budget = make_budget(max_steps, max_samples, max_wall_time, decimate)
     budget["drives"] = [d[0] for d in getattr(model, "_driven", ())]
     budget["integrator"] = integrator
+    budget.update(speeds=model.nu, span=t_end - t0)       # budget.warn_stiff's measures
     t_eval = _check_t_eval(t_eval, t0, t_end)
-    q, u = _initial_state(model, q0, u0)
-    if model.has_loops:
-        q, u = closed_initial_state(model, q, u, t0)
-    events = [as_event(e, model) for e in events]
+    q, u = _initial_state(model, q0, u0, t0)
+    given_events = list(events)
+    events = [as_event(e, model) for e in given_events]
     if events:
         check_conditions(events, model, t0, q, u)
     rhs = RightHandSide(model, method)
@@ -121,6 +125,15 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
         loop_report(model, result)
     if outputs or points:
         result.compute_outputs(outputs, points, frame=reactions_frame)
+    if error_estimate:
+        from .quality import estimate_error
+        same = {"t0": t0, "integrator": integrator, "rtol": rtol, "atol": atol, "dt": dt,
+                "method": method, "events": given_events, "max_step": max_step,
+                "compiled_loop": compiled_loop, "max_steps": max_steps,
+                "singularity_threshold": singularity_threshold,
+                "max_samples": max_samples, "max_wall_time": max_wall_time}
+        estimate_error(result, lambda **kw: simulate(model, t_end, q, u, **{**same, **kw}),
+                       integrator, rtol, atol, dt)
     return result
 
 
@@ -198,8 +211,9 @@ def _check_t_eval(t_eval, t0, t_end):
     return t_eval
 
 
-def _initial_state(model, q0, u0):
-    """``(q, u)`` from the arrays or ``{name: value}`` given, finite, unit quaternions."""
+def _initial_state(model, q0, u0, t0):
+    """``(q, u)`` from the arrays or ``{name: value}`` given, finite, unit quaternions; a
+    closed mechanism's on its constraints (``closed_loops``)."""
     try:
         q = model.q_vector(None if q0 is None else (dict(q0) if isinstance(q0, dict)
                                                     else q0)).copy()
@@ -216,6 +230,8 @@ def _initial_state(model, q0, u0):
         raise ModelError(f"initial state must be finite: q0/u0 hold NaN or Inf in "
                          f"{', '.join(bad)}")
     model.normalize_quaternions(q)
+    if model.has_loops:
+        q, u = closed_initial_state(model, q, u, t0)
     return q, u
 
 

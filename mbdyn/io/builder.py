@@ -207,7 +207,7 @@ class SceneBuilder:
             state = parse_effects(self.doc.get("effects"), known, where="")
         if self.effects_override is not None:
             try:
-                state = parse_effects(self.effects_override, known, "--effects", base=state)
+                state = parse_effects(self.effects_override, known, where="", base=state)
             except ModelError as exc:
                 raise ModelFileError("--effects", "", str(exc)) from None
         return state

@@ -38,8 +38,8 @@ def outputs_spec(scene):
             "points": {k: {"frame": f, "offset": list(o)} for k, (f, o) in out["points"].items()}}
 
 
-def summary(scene, result):
-    """The ``mbdyn run --json`` object::
+def summary(scene, result, quality=None):
+    """The ``mbdyn run --json`` object (``quality``: ``result.quality()`` unless given)::
 
         {"model": str, "case": str|null, "t_final": float, "q": {name: float},
          "u": {name: float}, "events": [{"name": str, "t": float}],
@@ -48,7 +48,16 @@ def summary(scene, result):
          "drive_efforts": {joint: float}|null, "points": {name: [x, y, z]}|null,
          "stats": {"integrator": str, "method": str, "steps": int,
                    "rhs_evaluations": int, "wall_time_s": float},
+         "quality": {"energy_drift": float|null, "quaternion_drift": float|null,
+                     "error_estimate": {"against": str, "difference": {name: float},
+                                        "relative": float, "worst": str}
+                                       |{"against": str|null, "failed": str}|null,
+                     "threshold": float, "warnings": [str]},
          "loops": {...}}          (closed mechanisms only: ``loop_summary``)
+
+    ``quality`` is what the run is worth (``mbdyn.integrate.quality.assess``): a figure
+    is ``null`` where not available (no energy balance, no quaternion, no estimate asked
+    for), and ``warnings`` has a sentence for each above the threshold.
     """
     model = scene.model
     energy = None
@@ -75,6 +84,7 @@ def summary(scene, result):
                   "steps": int(st.get("steps", 0)),
                   "rhs_evaluations": int(st.get("rhs_evaluations", 0)),
                   "wall_time_s": _float(st.get("wall_time_s", 0.0))},
+        "quality": _jsonable(result.quality() if quality is None else quality),
     }
     if model.has_loops:
         out["loops"] = loop_summary(result)

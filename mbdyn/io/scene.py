@@ -147,7 +147,8 @@ class Scene:
         Keywords override them: ``t_end``, ``integrator``, ``method``, ``rtol``, ``atol``,
         ``dt``, ``max_step``, ``output_dt`` (sampling of the result), ``events`` (a list
         of ``mb.Event``), ``outputs`` (a tuple of ``"reactions"``/``"energy"``),
-        ``points`` and ``progress`` (a callable ``progress(t)``).
+        ``points``, ``progress`` (a callable ``progress(t)``) and ``error_estimate``
+        (``simulate``'s).
         """
         unknown = set(overrides) - set(SIMULATE_KEYWORDS)
         if unknown:
@@ -185,7 +186,8 @@ class Scene:
         kwargs = dict(integrator=s["integrator"], rtol=s["rtol"], atol=s["atol"],
                       dt=s.get("dt") if fixed else None, method=s["method"],
                       events=overrides.get("events", self.events), t_eval=t_eval,
-                      progress=overrides.get("progress"), **budgets)
+                      progress=overrides.get("progress"),
+                      error_estimate=bool(overrides.get("error_estimate")), **budgets)
         if s.get("max_step"):
             kwargs["max_step"] = s["max_step"]
         if fixed and s.get("output_dt"):     # the integrator's own states, every k-th step

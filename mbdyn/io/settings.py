@@ -20,7 +20,7 @@ METHODS = ("auto",) + tuple(_METHODS) + ("symbolic",)
 DEFAULT_SIMULATION = dict(SIMULATE_DEFAULTS)     # one set of defaults (mbdyn.integrate.settings)
 SIMULATE_KEYWORDS = ("t_end", "integrator", "method", "rtol", "atol", "dt", "max_step",
                      "output_dt", "progress", "events", "outputs", "points", "max_steps",
-                     "max_samples", "max_wall_time")
+                     "max_samples", "max_wall_time", "error_estimate")
 BUDGETS = ("max_steps", "max_samples", "max_wall_time")
 
 

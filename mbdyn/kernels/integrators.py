@@ -138,9 +138,11 @@ def rk4_step(h, y, yn, drives, nq, slots, free_q, free_u, drive_q, drive_u, tree
 @njit(cache=True, inline="always")
 def midpoint_step(h, y, yn, drives, nq, slots, free_q, free_u, drive_q, drive_u,
                             tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev):
-    """Implicit midpoint (``implicit_midpoint_step`` with the common arguments)."""
-    return implicit_midpoint_step(y, h, drives[1], nq, slots, free_q, free_u, drive_q,
-                                  drive_u, tree, body, loads, ws, yn, k1, k2, tmp, J, nfev)
+    """Implicit midpoint (``implicit_midpoint_step`` with the common arguments; ``k1``
+    left holding ``y'`` at the step's start, as the other schemes leave it)."""
+    return implicit_midpoint_step(y, h, drives[0], drives[1], nq, slots, free_q, free_u,
+                                  drive_q, drive_u, tree, body, loads, ws, yn, k1, k3, k2,
+                                  tmp, J, nfev)
 
 
 @njit(cache=True, inline="always")
@@ -154,11 +156,13 @@ def _scratch(ny):
 # over all four would compile all of them: about 9 s of a first run).  The loops differ
 # only in the step they call.  After each step they check the run's event conditions
 # (``kernels.events``; ``times[n]``: the time after step ``n``) and return early, status 0,
-# after a step where a terminal one crossed zero or one is not finite.
+# after a step where a terminal one crossed zero or one is not finite.  Unless ``dout`` is
+# empty, ``dout[n]`` receives ``y'`` at the start of step ``n`` (``k1``, which every step
+# computes anyway): the derivatives of the cubic Hermite dense output (``samples``).
 
 @njit(cache=True)
 def euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, drive_u,
-               tree, body, loads, ws, out, nfev, times, events):
+               tree, body, loads, ws, out, dout, nfev, times, events):
     """``fixed_step_loop`` with explicit Euler."""
     _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
@@ -170,6 +174,8 @@ def euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, dr
                         drive_q, drive_u, tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
         if st:
             return n, st
+        if dout.shape[0]:
+            _copy(k1, dout[n])              # y' at the step's start, for dense output
         st = finish_step(out[n + 1], drive_table[n][2], nq, slots, quats, free_q, free_u,
                          drive_q, drive_u, tree, ws)
         if st:
@@ -181,7 +187,7 @@ def euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, dr
 
 @njit(cache=True)
 def semi_implicit_euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q,
-                             drive_u, tree, body, loads, ws, out, nfev, times, events):
+                             drive_u, tree, body, loads, ws, out, dout, nfev, times, events):
     """``fixed_step_loop`` with semi-implicit Euler."""
     _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
@@ -194,6 +200,8 @@ def semi_implicit_euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_
                                       k1, k2, k3, k4, tmp, J, nfev)
         if st:
             return n, st
+        if dout.shape[0]:
+            _copy(k1, dout[n])              # y' at the step's start, for dense output
         st = finish_step(out[n + 1], drive_table[n][2], nq, slots, quats, free_q, free_u,
                          drive_q, drive_u, tree, ws)
         if st:
@@ -205,7 +213,7 @@ def semi_implicit_euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_
 
 @njit(cache=True)
 def rk4_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, drive_u, tree,
-             body, loads, ws, out, nfev, times, events):
+             body, loads, ws, out, dout, nfev, times, events):
     """``fixed_step_loop`` with RK4."""
     _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
@@ -217,6 +225,8 @@ def rk4_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, driv
                       drive_q, drive_u, tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
         if st:
             return n, st
+        if dout.shape[0]:
+            _copy(k1, dout[n])              # y' at the step's start, for dense output
         st = finish_step(out[n + 1], drive_table[n][2], nq, slots, quats, free_q, free_u,
                          drive_q, drive_u, tree, ws)
         if st:
@@ -228,7 +238,7 @@ def rk4_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, driv
 
 @njit(cache=True)
 def implicit_midpoint_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q,
-                           drive_u, tree, body, loads, ws, out, nfev, times, events):
+                           drive_u, tree, body, loads, ws, out, dout, nfev, times, events):
     """``fixed_step_loop`` with the implicit midpoint rule."""
     _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
@@ -241,6 +251,8 @@ def implicit_midpoint_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u,
                            nfev)
         if st:
             return n, st
+        if dout.shape[0]:
+            _copy(k1, dout[n])              # y' at the step's start, for dense output
         st = finish_step(out[n + 1], drive_table[n][2], nq, slots, quats, free_q, free_u,
                          drive_q, drive_u, tree, ws)
         if st:
@@ -295,17 +307,18 @@ def fixed_step_loop(scheme, h, y0, drive_table, nq, slots, quats, free_q, free_u
 
 
 @njit(cache=True)
-def implicit_midpoint_step(y, h, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u,
-                           tree, body, loads, ws, yn, fm, fp, ym, J, nfev):
+def implicit_midpoint_step(y, h, drive_start, drive_vals, nq, slots, free_q, free_u, drive_q,
+                           drive_u, tree, body, loads, ws, yn, f0, fm, fp, ym, J, nfev):
     """``yn = y + h F((y + yn)/2)`` by Newton's method; the Jacobian of F by forward
-    differences at the explicit predictor's midpoint, kept for the step's iterations."""
+    differences at the explicit predictor's midpoint, kept for the step's iterations.
+    ``f0``: ``y'`` at the step's start (drive values ``drive_start``), the predictor's."""
     ny = y.shape[0]
-    st = _rhs(y, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads,
-              ws, fm, nfev)
+    st = _rhs(y, drive_start, nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads,
+              ws, f0, nfev)
     if st:
         return st
     for i in range(ny):
-        ym[i] = y[i] + 0.5 * h * fm[i]
+        ym[i] = y[i] + 0.5 * h * f0[i]
     st = _rhs(ym, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads,
               ws, fm, nfev)
     if st:

@@ -26,9 +26,13 @@ def plot_sweep(result, quantity, path, axes=None, title=None, ax=None):
     """Plot column ``quantity`` of a ``SweepResult`` over its grid ``axes`` (the override
     paths; default all): one axis a line, two a heat map (NaN cells -- no event, a failed
     member -- left blank).  Writes ``path`` (.png, .pdf, .svg; checked first) unless ``ax``
-    is given; returns the matplotlib figure."""
+    is given; returns the matplotlib figure.  ``quantity`` is a column name or a quantity
+    as ``sweep`` takes it (``"absmax:theta"`` for the column ``absmax.theta``)."""
+    from ..analysis.sweeps.quantities import column_of
     if ax is None:
         files.check_target(path, FORMATS, "picture")
+    if quantity not in result.columns:
+        quantity = column_of(quantity)
     if quantity not in result.columns:
         raise ModelError(f"--plot {quantity}: not a column of the table; the columns are: "
                          + ", ".join(result.columns))

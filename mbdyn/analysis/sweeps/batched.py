@@ -40,19 +40,17 @@ def batchable(scene, quantities):
 def run_batched(scenes, quantities):
     """Rows of members that share one compiled model (their scenes differ only in the
     initial state), advanced together by ``kernels.batched.batched_fixed_step``."""
+    from ...integrate.fixed_step import step_plan
     from ...kernels.batched import batched_fixed_step
     from ...kernels.integrators import SCHEMES, STAGES
     scene = scenes[0]
     model = scene.model
     s = scene.settings
     t0, t_end, dt = 0.0, float(s["t_end"]), float(s["dt"])
-    n_full = int(np.floor((t_end - t0) / dt * (1 + 1e-12)))       # as simulate plans it
-    times = t0 + dt * np.arange(1, n_full + 1)
-    if n_full and times[-1] > t_end:
-        times[-1] = t_end
+    times, h_last = step_plan(t0, t_end, dt)                       # as simulate plans it
+    n_full = len(times)
     t_last = times[-1] if n_full else t0
-    h_last = t_end - t_last if t_end - t_last > 1e-12 * max(1.0, abs(t_end)) else 0.0
-    starts = np.concatenate([[t0], times[:-1]])
+    starts = np.concatenate([[t0], times[:-1]])[:n_full]
     stage = (starts[:, None] + dt * np.array(STAGES)[None, :]).reshape(-1)
     table = model.drive_values(stage).reshape(n_full, len(STAGES), -1, 3)
     last = model.drive_values(t_last + h_last * np.array(STAGES)).reshape(1, len(STAGES), -1, 3)

@@ -38,9 +38,13 @@ def _whole(value, at_least=1):
 
 
 def check_arguments(scheduler, quantities, cases, fixed, workers, batch_size, out, resume,
-                    require_columns, scheduler_timeout):
+                    require_columns, scheduler_timeout, progress=None):
     """Refuse arguments of the wrong kind, naming the argument and what to give."""
     check_spec(scheduler)
+    if not (progress is None or isinstance(progress, bool) or callable(progress)):
+        raise ModelError(f"sweep: progress={brief(progress)}: give True (a progress bar), "
+                         "False (nothing), None (a counter on a terminal) or a function "
+                         "progress(done, total)")
     timeout = scheduler_timeout
     if timeout is not None and not (isinstance(timeout, numbers.Real) and not isinstance(
             timeout, bool) and math.isfinite(timeout) and timeout > 0):

@@ -95,3 +95,41 @@ def _duration(seconds):
     if seconds < 172800:
         return f"{seconds / 3600:.1f} h"
     return f"{seconds / 86400:.1f} days"
+
+
+class Callback:
+    """``progress(done, total)`` called after each finished member (``done`` counts the
+    members kept from before too)."""
+
+    def __init__(self, function, total, kept):
+        self.function, self.total, self.done = function, total, kept
+
+    def update(self):
+        self.done += 1
+        self.function(self.done, self.total)
+
+    def close(self):
+        pass
+
+
+class _Tqdm:
+    """tqdm's bar over the members, on stderr."""
+
+    def __init__(self, tqdm, total, kept):
+        self.bar = tqdm(total=total, initial=kept, unit="member", desc="mbdyn sweep",
+                        file=sys.stderr)
+
+    def update(self):
+        self.bar.update(1)
+
+    def close(self):
+        self.bar.close()
+
+
+def tqdm_bar(total, kept):
+    """A tqdm progress bar over the members if tqdm is installed, else ``None``."""
+    try:
+        from tqdm.auto import tqdm
+    except ImportError:
+        return None
+    return _Tqdm(tqdm, total, kept)

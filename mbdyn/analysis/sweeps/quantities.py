@@ -46,6 +46,14 @@ def columns(scene, quantities):
     return cols
 
 
+def column_of(name):
+    """The table column ``name`` stands for: a column name as it is, or a quantity as
+    ``-q`` spells it, ``STAT:X``, as its column ``STAT.X`` (``-q absmax:pitch`` makes the
+    column ``absmax.pitch``; ``--plot`` takes either back)."""
+    stat, sep, x = str(name).partition(":")
+    return f"{stat}.{x}" if sep and stat in STATS else str(name)
+
+
 def needs_energy(quantities):
     return any(q == "energy_drift" or q.endswith(":energy") for q in quantities)
 

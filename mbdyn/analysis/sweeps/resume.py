@@ -3,6 +3,8 @@ wrote (resume), each line and row checked against the sweep; ``read_table`` any 
 from __future__ import annotations
 
 import csv
+import itertools
+import json
 import os
 import stat
 
@@ -10,7 +12,16 @@ from ... import limits
 from ...errors import ModelError
 from ...escape import spreadsheet_text
 from ..arguments import brief
-from .table import FORMAT_LINE, STATUSES, as_arrays, as_number, cell, typed
+from .table import (
+    FORMAT_LINE,
+    SIDECAR_FORMAT,
+    STATUSES,
+    as_arrays,
+    as_number,
+    cell,
+    sidecar_path,
+    typed,
+)
 
 
 def _open_regular(path):
@@ -60,29 +71,77 @@ def _resume_error(path, line, problem):
                       "as mbdyn writes it -- remove it, or write elsewhere with --out")
 
 
+def read_sidecar(path):
+    """The sidecar JSON of the table ``path`` (``table.sidecar_path``) as a dict, read as
+    input (a regular file, at most ``limits.MAX_TABLE_LINE`` bytes, JSON of the format);
+    ``None`` if there is none."""
+    json_path = sidecar_path(path)
+    if not os.path.lexists(json_path):
+        return None
+    with _open_regular(json_path) as fh:
+        data = fh.read(limits.MAX_TABLE_LINE + 1)
+    problem, meta = None, None
+    if len(data) > limits.MAX_TABLE_LINE:
+        problem = f"is longer than {limits.MAX_TABLE_LINE} bytes"
+    else:
+        try:
+            meta = json.loads(data.decode("utf-8"))
+        except (ValueError, UnicodeDecodeError) as exc:
+            problem = f"is not JSON ({brief(str(exc), 80)})"
+    if problem is None and not (isinstance(meta, dict)
+                                and meta.get("format") == SIDECAR_FORMAT):
+        problem = "is not the sidecar of a sweep table as mbdyn writes it"
+    if problem:
+        raise ModelError(f"{json_path}: {problem}; remove it (and its table), or write "
+                         "elsewhere with --out")
+    return meta
+
+
+def _check_spec(table, first_line):
+    """Whether the table on disk is one of this sweep: its sidecar's fingerprint (or, in
+    a table of the old format, its first line's); returns the lines before the header
+    (0 or 1)."""
+    old = first_line.startswith(FORMAT_LINE)
+    if old:
+        spec = first_line[len(FORMAT_LINE):].rstrip("\n")
+    else:
+        meta = read_sidecar(table.path)
+        if meta is None:
+            raise ModelError(f"{table.path}: has no {os.path.basename(sidecar_path(table.path))}"
+                             " beside it, so it cannot be told to be a table of this sweep; "
+                             "remove it or write elsewhere with --out")
+        spec = meta.get("spec")
+    if spec != table.spec:
+        raise ModelError(f"{table.path}: not a table of this sweep (model, grid, "
+                         "cases or quantities differ); remove it or write elsewhere "
+                         "with --out")
+    return 1 if old else 0
+
+
 def read_done(table, members):
     """The rows a previous run of this sweep wrote to ``table`` (a ``Table``: its path,
     header and fingerprint), read as the input they are: a regular file, line by line
     (each at most ``limits.MAX_TABLE_LINE`` bytes, UTF-8, no NUL), every row checked
-    against the sweep's ``members``; errors name the file and the line.  The rows'
-    override and case cells are the members' own values.  [] if there is no table yet."""
+    against the sweep's ``members``; errors name the file and the line.  The table is
+    this sweep's if its sidecar's fingerprint is (or, in the old format, its first
+    line's).  The rows' override and case cells are the members' own values.  [] if
+    there is no table yet."""
     if not os.path.lexists(table.path):
         return []
     with _open_regular(table.path) as fh:
         lines = _table_lines(fh, table.path)
-        if next(lines, "") != FORMAT_LINE + table.spec + "\n":
-            raise ModelError(f"{table.path}: not a table of this sweep (model, grid, "
-                             "cases or quantities differ); remove it or write elsewhere "
-                             "with --out")
-        reader = csv.reader(lines)
+        first = next(lines, "")
+        skipped = _check_spec(table, first)
+        reader = csv.reader(lines if skipped else itertools.chain([first], lines))
         rows, seen = [], set()
         try:
             if next(reader, None) != [cell(c) for c in table.header]:
                 return []                    # no row yet, or another mbdyn's columns
             for cells in reader:     # at most one row per member (checked): bounded
-                rows.append(_kept_row(table, cells, reader.line_num + 1, members, seen))
+                rows.append(_kept_row(table, cells, reader.line_num + skipped, members,
+                                      seen))
         except csv.Error as exc:
-            raise _resume_error(table.path, reader.line_num + 1, str(exc)) from None
+            raise _resume_error(table.path, reader.line_num + skipped, str(exc)) from None
     return rows
 
 
@@ -126,7 +185,8 @@ def _kept_row(table, cells, line, members, seen):
 
 def read_table(path):
     """A sweep CSV as ``{column: array}`` (numbers as floats, text as objects; the
-    escapes of text cells undone), read with the bounds of a resume."""
+    escapes of text cells undone), read with the bounds of a resume; a table of the old
+    format's first line is skipped."""
     with _open_regular(path) as fh:
         lines = _table_lines(fh, path)
         reader = csv.reader(line for line in lines if not line.startswith(FORMAT_LINE))

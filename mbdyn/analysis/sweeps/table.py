@@ -1,9 +1,19 @@
-"""The table of a sweep: the CSV written row by row as members finish (``Table``), the
-values of its cells, and the Parquet copy.  Reading it back is ``resume``'s."""
+"""The table of a sweep: the CSV written row by row as members finish (``Table``) with its
+sidecar JSON, the values of its cells, and the Parquet copy.  Reading it back is
+``resume``'s.
+
+The CSV is a plain table -- a header, then one row per member -- that ``pandas.read_csv``
+reads as it is; what describes it (the sweep's fingerprint, model, quantities, columns,
+whether it is complete) is in ``NAME.json`` beside ``NAME.csv`` (``sidecar_path``), as a
+results CSV has its JSON.  Tables of mbdyn before this format began with a line
+``FORMAT_LINE + fingerprint``; they are still read (and resumed).
+"""
 from __future__ import annotations
 
 import csv
+import datetime
 import io
+import json
 import math
 import os
 
@@ -14,7 +24,16 @@ from ...errors import ModelError
 from ...escape import spreadsheet_cell
 
 STATUSES = ("ok", "failed", "error")
+#: the first line of a table of the old format (fingerprint after it); no longer written
 FORMAT_LINE = "# mbdyn sweep table v1 spec="
+#: the sidecar's ``format`` and ``version``
+SIDECAR_FORMAT, SIDECAR_VERSION = "mbdyn sweep table", 2
+
+
+def sidecar_path(csv_path):
+    """``NAME.json`` beside the table ``NAME.csv``."""
+    return str(csv_path)[:-4] + ".json" if str(csv_path).endswith(".csv") else \
+        str(csv_path) + ".json"
 
 
 def _fmt(v):
@@ -30,23 +49,53 @@ def cell(v):
 
 
 class Table:
-    """The CSV written row by row: a format line with the sweep's fingerprint, the
-    header, then one line per finished member (flushed and synced)."""
+    """The CSV written row by row (a header, then one line per finished member, flushed
+    and synced) and its sidecar JSON (``sidecar_path``: the fingerprint ``spec``, the
+    columns, ``meta`` -- model, quantities, ... --, and ``"status"``: ``"running"``, then
+    ``"complete"``).  The pair is replaced as ``mbdyn run --out``'s is: the old JSON
+    removed, the CSV renamed into place and the JSON last, signals held, so that a JSON
+    beside a CSV always describes it."""
 
-    def __init__(self, path, header, spec):
+    def __init__(self, path, header, spec, meta=None):
         self.path, self.header, self.spec = path, header, spec
+        self.meta = dict(meta or {})
+        self.json_path = sidecar_path(path)
         self.fh = None
 
+    def sidecar(self, status, rows):
+        """The sidecar's text."""
+        return json.dumps({
+            "format": SIDECAR_FORMAT, "version": SIDECAR_VERSION, "spec": self.spec,
+            "csv": os.path.basename(self.path), "status": status, "rows": rows,
+            "columns": list(self.header), **self.meta,
+            "written": datetime.datetime.now(datetime.UTC).isoformat(
+                timespec="seconds")}, indent=2, default=repr) + "\n"
+
+    def _install(self, csv_tmp, status, rows):
+        """Rename the finished CSV temporary and a new sidecar into place, as one unit."""
+        try:
+            json_tmp = files.write_temporary(self.json_path, self.sidecar(status, rows))
+        except BaseException:
+            files.remove(csv_tmp)
+            raise
+        with files.signals_held():
+            files.remove(self.json_path)
+            try:
+                files.replace(csv_tmp, self.path)
+            except BaseException:
+                files.remove(json_tmp)
+                raise
+            files.replace(json_tmp, self.json_path)
 
     def open(self, done_rows):
         """Start the table with the rows kept from a previous run: written whole beside
-        ``path`` and renamed over it (the old table stays until then; a symbolic link at
-        ``path`` is replaced, never written through), then appended to."""
+        ``path`` and renamed over it with its sidecar (the old table stays until then; a
+        symbolic link at ``path`` is replaced, never written through), then appended
+        to."""
         fd, tmp = files.temporary(self.path)
         self.fh = os.fdopen(fd, "w", encoding="utf-8", newline="")
         self.writer = csv.writer(self.fh, lineterminator="\n")
         try:
-            self.fh.write(FORMAT_LINE + self.spec + "\n")
             self.writer.writerow([cell(c) for c in self.header])
             for r in done_rows:
                 self.writer.writerow([cell(r.get(c, "")) for c in self.header])
@@ -55,7 +104,7 @@ class Table:
             self.close()
             files.remove(tmp)
             raise
-        files.replace(tmp, self.path)
+        self._install(tmp, "running", len(done_rows))
 
     def write(self, row):
         self.writer.writerow([cell(row.get(c, "")) for c in self.header])
@@ -71,15 +120,16 @@ class Table:
             self.fh = None
 
     def finish(self, rows):
-        """Rewrite the file sorted by member (whole or not at all: ``files``)."""
+        """Rewrite the file sorted by member, and its sidecar ``complete`` (whole or not
+        at all: ``files``)."""
         self.close()
         buf = io.StringIO()
-        buf.write(FORMAT_LINE + self.spec + "\n")
         w = csv.writer(buf, lineterminator="\n")
         w.writerow([cell(c) for c in self.header])
         for r in rows:
             w.writerow([cell(r.get(c, "")) for c in self.header])
-        files.atomic_write(self.path, buf.getvalue())
+        self._install(files.write_temporary(self.path, buf.getvalue()), "complete",
+                      len(rows))
 
 
 def as_number(v):
