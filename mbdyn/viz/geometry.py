@@ -7,7 +7,8 @@ to the child frame's origin and on to the child's centre of mass -- so every mod
 without edits.  Each frame's axes are drawn at its origin (x red, y green, z blue).
 Shapes (``mbdyn.elements.bodies.make_shape``) are drawn as wireframes: a box by its
 edges, a cylinder or disk by its two rims and four lines, a sphere by three great circles,
-a rod as a thick line.
+a rod as a thick line.  The joints that close loops are drawn in red, from each body's
+origin to the joint's point on it (``loop_lines``).
 """
 from __future__ import annotations
 
@@ -112,7 +113,36 @@ def instant(model, geometry, q, u, t):
         lines.append((np.array([r, kin.r_com[i]]), "#444444", 1.5))
         if g["mass"] > 0:
             markers.append((g["name"], kin.r_com[i].copy(), g["color"], g["size"]))
+    if getattr(model, "has_loops", False):
+        lines.extend(loop_lines(model, kin))
     return Scene3D(float(t), lines, markers, {})
+
+
+#: colour of the loop joints' links (the joints that close a loop)
+LOOP_COLOUR = "#d62728"
+
+
+def loop_lines(model, kin):
+    """Each loop joint drawn in red: a line from each body's frame origin to the joint's
+    point on it, and a distance constraint's rod between its two points (a coupling acts
+    on coordinates and is not drawn)."""
+    out = []
+    for name in model.loop_joints:
+        j = model.joint(name)
+        if j.kind == "coupling":
+            continue
+        points = []
+        for frame, s in ((j.parent, j.position), (j.child, j.child_position)):
+            if frame == "ground":
+                origin, point = np.zeros(3), np.asarray(s, float)
+            else:
+                i = model.frame_index(frame)
+                origin, point = kin.r[i], kin.r[i] + kin.R[i] @ s
+            out.append((np.array([origin, point]), LOOP_COLOUR, 2.5))
+            points.append(point)
+        if j.kind == "distance":
+            out.append((np.array(points), LOOP_COLOUR, 3.0))
+    return out
 
 
 def sample_times(result, fps=30.0, speed=1.0, max_frames=None):
