@@ -824,6 +824,11 @@ def test_a_large_star_compiles_and_steps_without_the_dense_system():
     snippet = r"""
 import resource, sys, time
 import mbdyn as mb
+warm = mb.System("warm-up")                 # the kernels compiled (or loaded) first
+warm.add_body("b", mass=1.0, inertia=(1e-3, 1e-3, 1e-3))
+warm.add_joint("j", "revolute", parent="ground", child="b", axis="z")
+mb.simulate(warm.compile(), 1e-3, integrator="rk4", dt=1e-3)
+base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 s = mb.System("star", gravity=(0, -9.81, 0))
 for i in range(2000):
     s.add_body(f"b{i}", mass=1.0, com=(0.1, 0, 0), inertia=(1e-3, 1e-3, 1e-3))
@@ -836,17 +841,17 @@ assert getattr(m, "_A", None) is None                 # never allocated
 assert m._JR.size == 0 and m._M.size == 0             # neither
 assert r.stats["mass_matrix_condition_initial"] is None
 held = sum(b.nbytes for b in m._packed[:2]) / 2**20
-print(held, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+print(held, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024 - base,
       time.perf_counter() - start)
 """
     out = subprocess.run([sys.executable, "-c", snippet], capture_output=True, text=True,
                          timeout=300, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
     assert out.returncode == 0, out.stderr
-    held_mb, peak_mb, step_s = map(float, out.stdout.split())
+    held_mb, growth_mb, step_s = map(float, out.stdout.split())
     # the model's arrays: O(n), about 4 MB here (the Jacobians and M would be 2 x 96 MB and
-    # 2 x 32 MB, the dense system 1.1 GB); the process's peak and the step's time include
-    # numba's first compile on a cold cache
-    assert held_mb < 20 and peak_mb < 1000 and step_s < 120, (held_mb, peak_mb, step_s)
+    # 2 x 32 MB, the dense system 1.1 GB); the peak's growth past the kernels' compile
+    # (which alone can take most of a gigabyte on a cold cache)
+    assert held_mb < 20 and growth_mb < 300 and step_s < 120, (held_mb, growth_mb, step_s)
 
 
 def test_the_model_file_size_limit_is_named_and_settable(tmp_path, monkeypatch):

@@ -44,7 +44,7 @@ def test_frame_with_two_parent_joints_is_refused():
     s.add_body("arm", mass=1.0, com=(1, 0, 0))
     s.add_joint("j1", "revolute", parent="ground", child="arm", axis="z")
     with pytest.raises(mb.ModelError,
-                       match=r"joint 'j2'.*'arm' already has a parent joint 'j1'.*exactly one"):
+                       match=r"joint 'j2'.*'arm' already has a parent joint 'j1'.*child_position"):
         s.add_joint("j2", "revolute", parent="bob", child="arm", axis="z")
 
 

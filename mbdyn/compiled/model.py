@@ -260,7 +260,8 @@ class Model:
               self._alpha, self._a, self._JR, self._JT, self._S, self._F, self._N, *work,
               self._scratch)
         if method == "jourdain" and self._con is not None:
-            ws += (self._con,)          # closed loops (kernels.routes)
+            ws += self._con             # closed loops (kernels.routes), flat: numba's
+            #                             parallel loops take no nested tuples
         return (self.nq, slots, quats, self._free_q, self._free_u, drive_q, drive_u,
                 tree, body, self._loads_arrays, ws)
 

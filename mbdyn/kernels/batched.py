@@ -15,13 +15,23 @@ from .integrators import fixed_step_loop
 
 
 def _own_workspace(ws):
-    """A private copy of the workspace arrays of ``Model.loop_arguments`` (either layout:
-    18 arrays for ``M u' = f``, 21 for the articulated-body algorithm)."""
+    """A private copy of the workspace arrays of ``Model.loop_arguments`` (each layout:
+    18 arrays for ``M u' = f``, 26 with a closed mechanism's constraints, 21 for the
+    articulated-body algorithm)."""
     raise NotImplementedError("compiled code only")
 
 
 @overload(_own_workspace, inline="always")
 def _own_workspace_layout(ws):
+    if len(ws) == 26:          # a closed mechanism: the Jourdain layout and its constraints
+        def constrained_layout(ws):
+            return (ws[0].copy(), ws[1].copy(), ws[2].copy(), ws[3].copy(), ws[4].copy(),
+                    ws[5].copy(), ws[6].copy(), ws[7].copy(), ws[8].copy(), ws[9].copy(),
+                    ws[10].copy(), ws[11].copy(), ws[12].copy(), ws[13].copy(),
+                    ws[14].copy(), ws[15].copy(), ws[16].copy(), ws[17].copy(),
+                    ws[18], ws[19], ws[20].copy(), ws[21].copy(), ws[22].copy(),
+                    ws[23].copy(), ws[24].copy(), ws[25].copy())
+        return constrained_layout
     if len(ws) == 18:
         def jourdain_layout(ws):
             return (ws[0].copy(), ws[1].copy(), ws[2].copy(), ws[3].copy(), ws[4].copy(),

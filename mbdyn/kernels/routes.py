@@ -30,17 +30,17 @@ def accelerations(tree, body, loads, ws, ud):
 @overload(accelerations, inline="always")
 def _accelerations_route(tree, body, loads, ws, ud):
     """The formulation is chosen when the loop is compiled, by the workspace's type: 18
-    arrays (``M``, ``f``, ``L``, scratch last) for ``M u' = f``, 19 (the same and the
-    constraints, ``Model._con``) for a closed mechanism, 21 (the articulated-body
+    arrays (``M``, ``f``, ``L``, scratch last) for ``M u' = f``, 26 (the same and the
+    eight arrays of the constraints, ``Model._con``) for a closed mechanism, 21 (the articulated-body
     workspace, then the scratch; ``tree`` then has empty ancestor lists) for the
     articulated-body algorithm.  A run compiles only its own route."""
-    if len(ws) == 19:
+    if len(ws) == 26:
         def constrained_route(tree, body, loads, ws, ud):
-            (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S, F, N, M, f, L, scratch,
-             con) = ws
+            (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S, F, N, M, f, L,
+             scratch) = ws[:18]
             return constrained_accelerations(tree, body, (qfull, ufull, udfull), loads,
                                              (R, r, w, v, alpha, a, JR, JT, S, F, N),
-                                             (M, f, L, ud), con, scratch)
+                                             (M, f, L, ud), ws[18:], scratch)
         return constrained_route
     if len(ws) == 18:
         def jourdain_route(tree, body, loads, ws, ud):
@@ -73,7 +73,7 @@ def finish_step(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_
 def _finish_step_route(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_u,
                        tree, ws):
     """Chosen by the workspace's layout, as ``accelerations``: a tree only normalises."""
-    if len(ws) == 19:
+    if len(ws) == 26:
         def project_route(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_u,
                           tree, ws):
             qfull, ufull, udfull = ws[0], ws[1], ws[2]
@@ -83,7 +83,7 @@ def _finish_step_route(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q,
                 udfull[drive_u[d]] = drive_vals[d, 2]
             _normalize(y, quats)
             steps = project_state(y, nq, slots, quats, free_q, free_u, tree,
-                                  (qfull, ufull, udfull), ws[3:14], ws[18], ws[17])
+                                  (qfull, ufull, udfull), ws[3:14], ws[18:], ws[17])
             return 5 if steps < 0 else 0
         return project_route
 
