@@ -2,6 +2,8 @@
 (issue 24, item 7): a four-bar on a torsional spring against its reduced 1-DoF equation
 derived here by hand, the flyball governor against its closed forms
 (``loop_references.governor_*``), and tree models left as they were."""
+import json
+import subprocess
 import sys
 import warnings
 from pathlib import Path
@@ -176,6 +178,17 @@ def test_four_bar_equilibrium_from_afar(sprung):
     assert far.q == pytest.approx(eq.q, abs=1e-9)
 
 
+def test_four_bar_mode_animation_stays_on_the_constraints(sprung):
+    from mbdyn.viz.modeshape import mode_motion
+    model, eq, _, _ = sprung
+    lin = mb.linearize(model, eq.q, eq.u)
+    res = mode_motion(lin, mb.modes(lin)[0], amplitude=0.2, samples=20)
+    phi = [np.abs(model.constraint_residuals(q)[0]).max() for q in res.q]
+    assert max(phi) < 1e-10
+    th2 = res.q[:, model.coordinate_index("th2")]
+    assert th2.max() - th2.min() > 0.05
+
+
 def test_a_body_hung_on_a_distance_rod_in_rotation_vector_coordinates():
     """A free body (position and quaternion) held by a massless rod of length ``L`` at a
     point ``e`` above its centre: the rod's one constraint leaves five coordinates, three
@@ -277,3 +290,17 @@ def test_tree_models_are_linearised_as_before():
     assert [m.frequency_hz for m in md] == pytest.approx([1.348, 8.734], abs=1e-3)
     with pytest.raises(ModelError, match="no closed loops"):
         mb.linearize(sc.model, eq.q, independent="theta1")
+
+
+def test_modes_command_on_a_closed_mechanism():
+    out = subprocess.run([sys.executable, "-m", "mbdyn", "modes", "models/watt_governor.toml",
+                          "--case", "steady", "--independent", "alpha1", "--json"],
+                         capture_output=True, text=True, cwd=HERE.parent, timeout=600)
+    assert out.returncode == 0, out.stderr
+    d = json.loads(out.stdout)
+    assert d["linearization"]["coordinates"] == ["alpha1"]
+    assert set(d["linearization"]["basis"]) == {"alpha1", "alpha2", "zs", "beta1", "beta2"}
+    assert d["equilibrium"]["independent"]
+    mode = d["modes"][0]
+    assert mode["natural_frequency"] == pytest.approx(governor_frequency(np.pi / 6), rel=1e-6)
+    assert mode["motion"]["beta2"][0] == pytest.approx(-2.0, rel=1e-8)
