@@ -13,6 +13,17 @@ Jacobian ``df/dq`` (central differences of the compiled model), a backtracking l
 search on ``|f|``, and ``scipy.optimize.root`` as the fallback.  A failure is an
 ``EquilibriumError`` carrying the last iterate; the result reports the residual, the
 iterations and the Jacobian's condition number.
+
+A closed mechanism (loop joints) rests on its constraints: the guess is first moved onto
+them (``Model.project``), and the unknowns are its independent coordinates
+(``analysis.reduction``), the dependent ones solved from the constraints at every
+evaluation.  The equations are the reduced ones, ``S^T M S w' = 0`` with ``w'`` the
+independent part of the constrained accelerations (``M u' = f + G^T lam``, ``G u' =
+gamma``): at rest ``S^T f = 0``, the generalized forces projected on the motions the loops
+allow.  The speeds of the independent coordinates are the given ones (zero at rest), the
+dependent speeds follow from the constraints.  After each Newton step the chart is centred
+again on the new configuration, the partition kept (chosen again by pivoted QR only where
+it has become ill-conditioned), so a far equilibrium does not strain it.
 """
 from __future__ import annotations
 
@@ -46,6 +57,8 @@ class Equilibrium:
     condition: float
     method: str
     time_dependent: bool = False
+    #: closed loops: the independent coordinates the equations were solved in
+    independent: tuple = ()
 
     def to_dict(self):
         m = self.model
@@ -53,7 +66,8 @@ class Equilibrium:
                 "u": dict(zip(m.speeds, self.u.tolist())), "t": self.t,
                 "residual": self.residual, "iterations": self.iterations,
                 "condition": self.condition, "method": self.method,
-                "time_dependent": self.time_dependent}
+                "time_dependent": self.time_dependent,
+                **({"independent": list(self.independent)} if self.independent else {})}
 
 
 def _unknowns(model, tangent, fixed):
@@ -107,6 +121,8 @@ def equilibrium(model, q_guess=None, u=None, t=0.0, fixed=(), tol=1e-10, max_ite
     """
     model, q0, u, t, tol, max_iter, fixed = _checked(model, q_guess, u, t, fixed, tol,
                                                      max_iter)
+    if model.has_loops:
+        return _loop_equilibrium(model, q0, u, t, fixed, tol, max_iter)
     tangent = Tangent(model, q0)
     free = _unknowns(model, tangent, fixed)
     if not free:
@@ -128,6 +144,89 @@ def equilibrium(model, q_guess=None, u=None, t=0.0, fixed=(), tol=1e-10, max_ite
     time_dependent = bool(max(np.abs(f).max() for f in later) > 1e3 * tol * scale)
     return Equilibrium(model, q, u, float(t), float(np.abs(r).max()), iterations, cond,
                        method, time_dependent)
+
+
+class _LoopEquations(_Equations):
+    """A closed mechanism's reduced equations ``(S^T M S w')[free] = 0`` as functions of
+    the free independent tangent coordinates about ``red.q0`` (``red``: a
+    ``reduction.Reduction``; ``free``: positions in ``red.independent``; ``w``: the
+    independent speeds)."""
+
+    def __init__(self, model, red, free, w, t):
+        super().__init__(model, red.tangent, free, w, t)
+        self.red = red
+
+    def residual(self, x_free):
+        q = self.configuration(x_free)
+        if q is None:                   # the loops do not close there: a failed trial
+            return np.full(len(self.free), np.nan)
+        return self.at(q)
+
+    def at(self, q):
+        red, model = self.red, self.model
+        u = red.speeds(q, self.u)
+        ud = model.forward_dynamics(q, u, self.t)[red.independent]
+        S = red.velocity_map(q)
+        return (S.T @ model.mass_matrix(q, self.t) @ S @ ud)[self.free]
+
+    def configuration(self, x_free):
+        z = np.zeros(self.red.n)
+        z[self.free] = x_free
+        return self.red.configuration(z)
+
+
+def _loop_equations(model, q, u, t, held, before=None):
+    """The ``_LoopEquations`` about ``q`` (on the constraints): the partition of the
+    equations ``before``, unless it has become ill-conditioned at ``q`` (or there are none
+    before), then one chosen by pivoted QR with the ``held`` speeds independent; ``u``: the
+    speeds (its independent part is kept)."""
+    from .reduction import REPARTITION_BELOW, Reduction
+    red = None if before is None else Reduction(model, q, t, dependent=before.red.dependent)
+    if red is None or red.condition < REPARTITION_BELOW:
+        red = Reduction(model, q, t, held=held)
+    if red.n == 0:
+        raise ModelError(f"equilibrium: model {model.name!r} has no degrees of freedom: "
+                         "its loops and drives fix every coordinate")
+    free = [k for k, i in enumerate(red.independent) if i not in set(held)]
+    if not free:
+        raise ModelError("equilibrium: every independent coordinate of the closed "
+                         "mechanism is held fixed; nothing to solve")
+    return _LoopEquations(model, red, free, u[red.independent], t)
+
+
+def _loop_equilibrium(model, q0, u, t, fixed, tol, max_iter):
+    """``equilibrium`` of a closed mechanism: Newton-Raphson on its reduced equations,
+    the chart centred again after each step (the module's docstring)."""
+    q0, u = model.project(q0, u, t)
+    tangent = Tangent(model, q0)
+    free = set(_unknowns(model, tangent, fixed))
+    held = [k for k in range(tangent.n) if k not in free]
+    eqs = _loop_equations(model, q0, u, t, held)
+    r = eqs.residual(np.zeros(len(eqs.free)))
+    scale = _force_scale(model, q0, u, t, r)
+    iterations, cond = 0, np.inf
+    while np.abs(r).max() > tol * scale and iterations < max_iter:
+        x, r, steps, cond = _newton(eqs, np.zeros(len(eqs.free)), r, tol, scale, 1)
+        iterations += steps
+        if not np.any(x) or steps == 0:
+            break                                  # no step lowered |f|
+        q = eqs.configuration(x)
+        eqs = _loop_equations(model, q, eqs.red.speeds(q, eqs.u), t, held, eqs)
+        r = eqs.residual(np.zeros(len(eqs.free)))
+    x, method = np.zeros(len(eqs.free)), "newton"
+    if np.abs(r).max() > tol * scale:
+        method = "scipy.optimize.root (hybr)"
+        x, r, iterations, cond = _fallback(eqs, x, r, tol, scale, iterations)
+    q = eqs.configuration(x)
+    _warn_if_singular(model, q)
+    later = []
+    for dt in (0.37, 1.3, 4.1):
+        eqs_t = _loop_equations(model, q, eqs.red.speeds(q, eqs.u), t + dt, held, eqs)
+        later.append(eqs_t.residual(np.zeros(len(eqs_t.free))))
+    time_dependent = bool(max(np.abs(f).max() for f in later) > 1e3 * tol * scale)
+    return Equilibrium(model, q, eqs.red.speeds(q, eqs.u), float(t),
+                       float(np.abs(r).max()), iterations, cond, method, time_dependent,
+                       eqs.red.names)
 
 
 def _checked(model, q_guess, u, t, fixed, tol, max_iter):

@@ -19,6 +19,13 @@ Two routes: ``"numeric"`` differentiates the compiled model by central differenc
 step chosen per coordinate, and reports an error estimate (the difference to the
 derivative with twice the step, over three: the leading truncation error of the central
 formula); ``"symbolic"`` differentiates the closed-form equations of ``mb.derive`` exactly.
+
+A closed mechanism (loop joints) is linearised in independent coordinates
+(``analysis.reduction``): ``x`` above becomes the independent tangent coordinates ``z``,
+the dependent ones following on the constraints, ``u`` the independent speeds ``w``, ``g``
+the constrained accelerations' independent part (``M u' = f + G^T lam``, ``G u' = gamma``)
+and ``M`` the reduced mass matrix ``S^T M S``.  Differentiating on the constraints keeps the
+geometric stiffness of the constraint forces, which ``S^T (df/dq) S`` would miss.
 """
 from __future__ import annotations
 
@@ -50,6 +57,14 @@ class Linearization:
     route: str = "numeric"
     error: float | None = None
     details: dict = field(default_factory=dict)
+    #: closed loops: every tangent coordinate's name, and ``basis`` (all x independent):
+    #: how each moves with the independent ones ``names``, ``dx = basis @ dz`` to first
+    #: order.  A tree has no dependent coordinates: ``coordinates == names``, no basis.
+    coordinates: tuple = ()
+    basis: np.ndarray | None = None
+
+    def __post_init__(self):
+        self.coordinates = tuple(self.coordinates) or tuple(self.names)
 
     @property
     def C(self):
@@ -73,10 +88,14 @@ class Linearization:
                                     "q": dict(zip(m.coordinates, self.q0.tolist())),
                                     "u": dict(zip(m.speeds, self.u0.tolist()))},
                 "route": self.route, "error_estimate": self.error,
-                **{k: getattr(self, k).tolist() for k in ("M", "D", "G", "K", "N")}}
+                **{k: getattr(self, k).tolist() for k in ("M", "D", "G", "K", "N")},
+                **({} if self.basis is None else {
+                    "all_coordinates": list(self.coordinates),
+                    "basis": {nm: row.tolist() for nm, row in zip(self.coordinates,
+                                                                   self.basis)}})}
 
 
-def _split(C, Kt, M, names, model, q0, u0, t, route, error, details):
+def _split(C, Kt, M, names, model, q0, u0, t, route, error, details, reduction=None):
     D, G = 0.5 * (C + C.T), 0.5 * (C - C.T)
     K, N = 0.5 * (Kt + Kt.T), 0.5 * (Kt - Kt.T)
     n = len(names)
@@ -87,8 +106,11 @@ def _split(C, Kt, M, names, model, q0, u0, t, route, error, details):
                                       "the operating point; it cannot be linearised there") \
             from None
     A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ Kt, -Minv @ C]])
-    return Linearization(model, tuple(names), q0, u0, float(t), M, D, G, K, N, A, route,
-                         error, details)
+    lin = Linearization(model, tuple(names), q0, u0, float(t), M, D, G, K, N, A, route,
+                        error, details)
+    if reduction is not None:
+        lin.coordinates, lin.basis = tuple(reduction.tangent.names), reduction.S
+    return lin
 
 
 def _operating_point(model, q0, u0):
@@ -105,7 +127,8 @@ def _operating_point(model, q0, u0):
     return q0, u0
 
 
-def linearize(model, q0=None, u0=None, t=0.0, route="numeric", step=None):
+def linearize(model, q0=None, u0=None, t=0.0, route="numeric", step=None,
+              independent=None):
     """Linearise ``model`` about the coordinates ``q0`` and speeds ``u0`` (arrays or
     ``{name: value}``; default the model's zero state) at time ``t``.
 
@@ -113,6 +136,10 @@ def linearize(model, q0=None, u0=None, t=0.0, route="numeric", step=None):
     the per-coordinate step, default the cube root of the machine epsilon) or
     ``"symbolic"`` (exact derivatives of the closed-form equations).  Returns a
     ``Linearization``.
+
+    A closed mechanism is linearised in independent coordinates, chosen by pivoted QR of
+    the constraint Jacobian unless ``independent`` names them (coordinates or joints); the
+    operating point is first moved onto the constraints (``Model.project``).
     """
     where = "linearize"
     model = arguments.model(model, where)
@@ -125,6 +152,15 @@ def linearize(model, q0=None, u0=None, t=0.0, route="numeric", step=None):
                               arguments.state(u0, where, "u0"))
     if model.nu == 0:
         raise ModelError(f"model {model.name!r} has no degrees of freedom to linearise")
+    if model.has_loops:
+        if route != "numeric":
+            raise ModelError(f"model {model.name!r} has closed loops: linearise it by the "
+                             "numeric route (the symbolic equations are the tree's)")
+        independent = arguments.names(independent or (), where, "independent")
+        return _loop_linearization(model, q0, u0, t, step, independent)
+    if independent:
+        raise ModelError(f"linearize: model {model.name!r} has no closed loops; its "
+                         "coordinates are all independent (leave out independent)")
     tangent = Tangent(model, q0)
     M = model.mass_matrix(q0, t)
     B = tangent.rate_coupling(u0)
@@ -145,6 +181,45 @@ def linearize(model, q0=None, u0=None, t=0.0, route="numeric", step=None):
 
 def _accelerations(model, q, u, t):
     return model.forward_dynamics(q, u, t)
+
+
+def _loop_linearization(model, q0, u0, t, step, independent):
+    """``linearize`` of a closed mechanism, in the independent coordinates of
+    ``analysis.reduction`` (the module's docstring)."""
+    from .reduction import Reduction, speed_indices
+    q0, u0 = model.project(q0, u0, t)
+    chosen = speed_indices(model, Tangent(model, q0), independent, "linearize")
+    red = Reduction(model, q0, t, independent=chosen)
+    if red.n == 0:
+        raise ModelError(f"model {model.name!r} has no degrees of freedom to linearise: "
+                         "its loops fix every coordinate")
+    w0 = u0[red.independent]
+    u0 = red.speeds(q0, w0)
+
+    def on_constraints(z, w):
+        q = red.configuration(z)
+        if q is None:
+            raise ModelError(f"linearize: the loops of model {model.name!r} cannot be "
+                             "closed next to the operating point (a singular configuration?)")
+        return _accelerations(model, q, red.speeds(q, w), t)[red.independent]
+
+    eps = np.finfo(float).eps
+    base = eps ** (1 / 3) if step is None else float(step)
+    hz = base / np.maximum(1.0, np.abs(red.S).max(axis=0))   # no coordinate moves more
+    hw = base * np.maximum(1.0, np.abs(w0))
+    Gz, Gz2 = _central(lambda z: on_constraints(z, w0), np.zeros(red.n), hz)
+    Gw, Gw2 = _central(lambda w: on_constraints(np.zeros(red.n), w), w0, hw)
+    scale = max(np.abs(Gz).max(initial=0.0), np.abs(Gw).max(initial=0.0), 1e-300)
+    error = max(np.abs(Gz - Gz2).max(initial=0.0), np.abs(Gw - Gw2).max(initial=0.0)) / 3
+    S = red.S
+    M = S.T @ model.mass_matrix(q0, t) @ S
+    B = (red.tangent.rate_coupling(u0) @ S)[red.independent]
+    C = -M @ (Gw + B)
+    Kt = -M @ (Gz - Gw @ B)
+    details = {"independent": red.names, "constraint_rank": red.rank,
+               "partition_condition": red.condition}
+    return _split(C, Kt, M, red.names, model, q0, u0, t, "numeric", float(error / scale),
+                  details, red)
 
 
 def _central(fn, x0, steps):

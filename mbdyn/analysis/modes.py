@@ -9,6 +9,10 @@ are listed with ``w_d = 0``.  Zero eigenvalues are rigid-body modes (a coordinat
 does not restrain) and are flagged ``rigid``.  The model is stable when every real part is
 negative (``stability`` says which mode is not).
 
+A closed mechanism's linearisation is in independent coordinates (``lin.names``); each
+mode also carries ``motion``, the shape over every coordinate (``lin.coordinates``: the
+dependent ones follow through ``lin.basis``), scaled as ``shape``.
+
 Whirl: for a rotor, give the pairs of lateral coordinates ``(y, z)`` that span planes
 across the spin axis, with ``y x z`` along the spin: a mode whirls *forward* when its orbit
 turns the same way as the spin, *backward* otherwise.
@@ -38,6 +42,14 @@ class Mode:
     rigid: bool
     whirl: str | None = None       # "forward", "backward" or None
     tolerance: float = 0.0         # |real part| below this: neutrally stable (undamped)
+    #: closed loops: the shape over every coordinate (independent and dependent), named
+    #: by ``coordinates``; for a tree the same as ``shape``
+    motion: np.ndarray | None = None
+    coordinates: tuple = ()
+
+    def __post_init__(self):
+        if self.motion is None:
+            self.motion, self.coordinates = self.shape, tuple(self.names)
 
     @property
     def frequency_hz(self):
@@ -60,7 +72,10 @@ class Mode:
                 "damping_ratio": self.damping_ratio, "log_decrement": self.log_decrement,
                 "rigid": bool(self.rigid), "stable": bool(self.stable), "whirl": self.whirl,
                 "shape": {n: [c.real, c.imag] for n, c in zip(self.names, self.shape)},
-                "participation": dict(zip(self.names, self.participation.tolist()))}
+                "participation": dict(zip(self.names, self.participation.tolist())),
+                **({} if self.coordinates == tuple(self.names) else {
+                    "motion": {n: [c.real, c.imag]
+                               for n, c in zip(self.coordinates, self.motion)}})}
 
     def __repr__(self):
         tag = " rigid" if self.rigid else ""
@@ -126,6 +141,8 @@ class Modes:
             lines.append(f"{k:>3} {m.frequency_hz:>12.6g} {m.damped_frequency:>13.6g} "
                          f"{m.natural_frequency:>13.6g} {m.damping_ratio:>10.4g} {ld}  "
                          f"{dom}{tag}")
+            if m.coordinates != tuple(m.names):
+                lines.append(f"{'':>4}with {_dependent_motion(m)}")
         lines.append(self.stability)
         return "\n".join(lines)
 
@@ -185,7 +202,25 @@ def modes(lin, whirl=(), spin=1.0, rigid_tolerance=1e-7):
     out.sort(key=lambda m: (m.natural_frequency, m.damped_frequency))
     if whirl:
         _circular_pairs(out, whirl, index, spin)
+    for m in out:       # closed loops: the dependent coordinates follow the independent
+        m.motion = m.shape if lin.basis is None else lin.basis @ m.shape
+        m.coordinates = tuple(lin.coordinates)
     return Modes(lin, out, values)
+
+
+def _dependent_motion(mode):
+    """``th4 0.195, th3 -1.21``: how the dependent coordinates move in a mode, per unit of
+    its largest independent one (a magnitude and phase where it is not in or out of
+    phase)."""
+    parts = []
+    for name, c in zip(mode.coordinates, mode.motion):
+        if name in mode.names:
+            continue
+        if abs(c.imag) <= 1e-9 * max(abs(c), 1e-300):
+            parts.append(f"{name} {c.real:.4g}")
+        else:
+            parts.append(f"{name} {abs(c):.4g} at {np.degrees(np.angle(c)):.0f} deg")
+    return ", ".join(parts)
 
 
 def _turn(shape, whirl, index):

@@ -32,6 +32,9 @@ def run(args):
       f"{fmt(eq.residual)}, Jacobian condition {fmt(eq.condition)}\n")
     if eq.time_dependent:
         w("  (the equations depend on time here: this is the equilibrium at t only)\n")
+    if eq.independent:
+        w(f"  closed loops: solved in the independent coordinates "
+          f"{', '.join(eq.independent)}, the others on the constraints\n")
     width = max(len(n) for n in scene.model.coordinates)
     for n, v in zip(scene.model.coordinates, eq.q):
         w(f"    {n:<{width}} = {fmt(v)}\n")

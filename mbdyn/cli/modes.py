@@ -3,6 +3,11 @@
     mbdyn modes MODEL [--case NAME] [--set PATH=VALUE ...] [--effects LIST]
                       [--at equilibrium|initial] [--route numeric|symbolic]
                       [--fixed NAMES] [--whirl Y,Z ...] [--t T] [--json]
+                      [--independent NAMES]
+
+A closed mechanism is linearised in independent coordinates (chosen by pivoted QR of the
+constraint Jacobian, or named by ``--independent``); each mode lists how the dependent
+coordinates move with them.
 """
 from __future__ import annotations
 
@@ -28,6 +33,9 @@ def register(subparsers):
                    help="which mode --animate draws (1 = the lowest, as listed)")
     p.add_argument("--amplitude", type=positive, default=0.1,
                    help="--animate's amplitude in the tangent coordinates (rad or m)")
+    p.add_argument("--independent", metavar="NAMES", default="",
+                   help="closed loops: the independent coordinates (comma-separated); "
+                        "default: chosen by pivoted QR of the constraint Jacobian")
     add_vibration_arguments(p)
 
 
@@ -47,7 +55,8 @@ def run(args):
     if args.at == "equilibrium":
         eq = equilibrium(model, q, u, t=args.t, fixed=names(args.fixed))
         q = eq.q
-    lin = linearize(model, q, u, t=args.t, route=args.route)
+    lin = linearize(model, q, u, t=args.t, route=args.route,
+                    independent=names(args.independent) or None)
     md = modes(lin, whirl=whirl_pairs(args))
     if args.animate:
         from ..errors import ModelError
@@ -64,6 +73,10 @@ def run(args):
     w(f"{heading(scene)}: linearised at the {args.at} state by the {args.route} route"
       + (f" (error estimate {lin.error:.1e})" if lin.route == "numeric" else "") + "\n")
     w(f"  coordinates: {', '.join(lin.names)}\n")
+    if lin.basis is not None:
+        dependent = [n for n in lin.coordinates if n not in lin.names]
+        w(f"  closed loops: independent coordinates {', '.join(lin.names)}; "
+          f"{', '.join(dependent)} follow on the constraints\n")
     if args.matrices:
         with np.printoptions(precision=6, suppress=False, linewidth=100):
             for k in ("M", "D", "G", "K", "N"):

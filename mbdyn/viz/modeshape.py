@@ -4,7 +4,9 @@ The motion ``x(t) = amplitude Re(phi e^{s t})`` of a mode (``mbdyn.analysis.mode
 the tangent coordinates of the linearisation is mapped back to coordinates
 (``analysis.tangent``) and drawn like a run: two periods, slowed or sped up so that one
 period lasts ``period_seconds`` of playback.  The growth or decay of the mode is shown
-too (its real part), unless ``steady=True``.
+too (its real part), unless ``steady=True``.  A closed mechanism's mode moves every
+coordinate (``Mode.motion``), and each frame is put back on the constraints
+(``Model.project``: the linear motion leaves them at second order).
 """
 from __future__ import annotations
 
@@ -26,10 +28,13 @@ def mode_motion(lin, mode, amplitude=0.1, periods=2.0, samples=200, steady=False
     t = np.linspace(0.0, periods * T, samples)
     s = complex(0.0 if steady else mode.eigenvalue.real, mode.damped_frequency)
     tangent = Tangent(model, lin.q0)
-    x = amplitude * np.real(np.outer(np.exp(s * t), mode.shape))
-    xd = amplitude * np.real(np.outer(s * np.exp(s * t), mode.shape))
+    x = amplitude * np.real(np.outer(np.exp(s * t), mode.motion))
+    xd = amplitude * np.real(np.outer(s * np.exp(s * t), mode.motion))
     q = np.array([tangent.retract(row) for row in x])
     u = lin.u0 + xd
+    if model.has_loops:
+        for k in range(len(t)):
+            q[k], u[k] = model.project(q[k], u[k], lin.t)
     return Result(model, t, q, u, [], {"mode_frequency_hz": mode.frequency_hz})
 
 
