@@ -149,6 +149,22 @@ def _crossings(x, y):
     return out
 
 
+def _onsets(x, real, freq):
+    """Values of ``x`` where a real part turns from negative to positive (an onset of
+    instability).  A real part within round-off of zero (an undamped mode: exactly 0, or
+    1e-12 of its frequency) is neutral: it is no onset, and neither is staying at zero."""
+    tol = 1e-9 * (np.abs(freq) + 1e-12)
+    sign = np.where(np.abs(real) <= tol, 0, np.sign(real))
+    out, last = [], None                      # the last sample with a definite sign
+    for i in range(len(x)):
+        if sign[i] == 0:
+            continue
+        if last is not None and sign[last] < 0 < sign[i]:
+            out.append(float(x[last] - real[last] * (x[i] - x[last]) / (real[i] - real[last])))
+        last = i
+    return out
+
+
 def _builder(scene, parameter):
     """``value -> (model, q0, u0)``: a model file's scene rebuilt with the parameter set,
     or a user's function of the value returning a ``Model`` (or a scene)."""
@@ -306,7 +322,7 @@ def _crossings_of(values, freq, real, orders, spin_is_parameter):
                     if oscillating[i] and oscillating[i + 1]:
                         critical.extend((k, o, v) for v in _crossings(values[i:i + 2],
                                                                         gap[i:i + 2]))
-        for v in _crossings(values, real[:, k]):
+        for v in _onsets(values, real[:, k], freq[:, k]):
             onset.append((k, v))
     critical.sort(key=lambda c: c[2])
     onset.sort(key=lambda c: c[1])
