@@ -371,3 +371,64 @@ def test_force_elements_effects_and_events_on_a_closed_mechanism():
     assert len(res.events) == 1 and res.events[0][1] == res.t[-1] < 2.0
     assert abs(res.q[-1, m.coordinate_index("th4")] - 2.0) < 1e-8
     assert res.stats["constraint_drift"] <= 1e-10
+
+
+HOOKE_BETA = 0.5        # rad between the input and output shafts
+
+
+def _hooke(tree_universal):
+    """Hooke's (Cardan) joint: input shaft along x (driven), output shaft along
+    d = (cos b, sin b, 0); the cross joins the input yoke's arm y to the output yoke's arm
+    z.  Closed by a universal loop joint between the shafts, or (``tree_universal``) the
+    output shaft hung on a universal tree joint and closed by its bearing, a revolute about
+    d to the ground."""
+    d = (np.cos(HOOKE_BETA), np.sin(HOOKE_BETA), 0.0)
+    s = mb.System("hooke", gravity=(0, 0, 0))
+    s.add_body("A", mass=1.0, inertia=(0.01, 0.02, 0.02))
+    s.add_body("B", mass=1.0, inertia=(0.01, 0.02, 0.02))
+    s.add_joint("input", "revolute", "ground", "A", axis="x", drive=1.0 * mb.t)
+    if tree_universal:
+        s.add_joint("cross", "universal", "A", "B", axis="y", axis2="z")
+        s.add_joint("bearing", "revolute", "ground", "B", axis=d, child_position=(0, 0, 0))
+    else:
+        s.add_joint("out", "revolute", "ground", "B", axis=d)
+        s.add_joint("cross", "universal", "A", "B", axis="y", axis2="z",
+                    child_position=(0, 0, 0))
+    return s.compile()
+
+
+@pytest.mark.parametrize("tree_universal", [False, True])
+def test_hookes_joint_against_its_closed_form(tree_universal):
+    """tan th2 = tan th1 / cos b (the input yoke's arm in the shafts' plane at th1 = 0):
+    a universal joint closing the loop, and a universal tree joint, both give it; the
+    output's rate is th1' cos b / (cos^2 b cos^2 th1 + sin^2 th1)."""
+    m = _hooke(tree_universal)
+    d = np.array([np.cos(HOOKE_BETA), np.sin(HOOKE_BETA), 0.0])
+    cb = np.cos(HOOKE_BETA)
+    for t in np.linspace(0.05, 3.0, 7):
+        th2 = np.arctan2(np.sin(t), np.cos(t) * cb)
+        guess = ({"cross_1": 0.0, "cross_2": 0.0} if tree_universal else {"out": th2 + 0.1})
+        q, u = m.assemble(guess=guess, t=t)
+        assert m.mobility(q, t) == 0
+        kin = m.kinematics(q, u, t=t)
+        iB = m.frame_index("B")
+        arm = kin.R[iB][:, 2]                          # the output yoke's arm, world
+        expected = np.cos(th2) * np.array([0, 0, 1.0]) + np.sin(th2) * np.cross(d, [0, 0, 1])
+        if not tree_universal:
+            assert abs(wrap(q[m.coordinate_index("out")] - th2)) < 1e-10
+        np.testing.assert_allclose(arm, expected, atol=1e-10)
+        rate = cb / (cb ** 2 * np.cos(t) ** 2 + np.sin(t) ** 2)
+        assert abs(kin.w[iB] @ d - rate) < 1e-10
+
+
+def test_tree_universal_and_cylindrical_are_two_joints_through_a_cross():
+    s = mb.System("parts")
+    s.add_body("b", mass=1.0, inertia=(1, 1, 1))
+    s.add_body("c", mass=1.0, inertia=(1, 1, 1))
+    s.add_joint("u", "universal", "ground", "b", axis="z", axis2="x")
+    s.add_joint("cy", "cylindrical", "b", "c", axis="y", position=(0, 0, -1))
+    m = s.compile()
+    assert m.coordinates == ("u_1", "u_2", "cy_slide", "cy_turn")
+    assert "u.cross" in m.frames
+    with pytest.raises(mb.ModelError, match="not perpendicular"):
+        s.add_joint("bad", "universal", "c", "ground", axis="z", axis2=(1, 0, 1))

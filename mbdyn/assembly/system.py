@@ -23,6 +23,7 @@ from ..elements.loads import make_load
 from ..errors import ModelError, ModelWarning, SingularMassMatrixError
 from ..limits import magnitude_problem
 from ..names import identifier_problem, label_problem
+from .composite import add_composite_joint
 from .loops import add_loop_joint, check_loops, loop_bodies
 from ..elements.forces import GLOBAL_EFFECTS, make_force
 
@@ -155,8 +156,16 @@ class System:
         between ``position`` on the parent and ``child_position`` on the child) and
         ``"coupling"`` (``follower``, ``leader``, ``ratio``, ``offset``: ``q_follower =
         ratio q_leader + offset``; no parent or child).  ``child_orientation`` places the
-        joint frame in the child.
+        joint frame in the child.  In the tree, ``universal`` and ``cylindrical`` are two
+        1-DoF joints through a massless frame (``assembly.composite``).
         """
+        closing = {k for k in loop if k not in ("axis2",)}
+        if kind in ("universal", "cylindrical") and not closing:
+            return add_composite_joint(self, name, kind, parent, child, axis=axis,
+                                       position=position, orientation=orientation,
+                                       coordinates=coordinates, drive=drive,
+                                       axis2=loop.get("axis2"), sequence=sequence,
+                                       speeds=speeds)
         if loop or kind in ("distance", "coupling"):
             return add_loop_joint(self, name, kind, parent, child, axis=axis,
                                   position=position, orientation=orientation, **loop)

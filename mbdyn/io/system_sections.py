@@ -79,6 +79,10 @@ def add_joints(b):
     for path, j, name in b.entries("joints", "joint"):
         kind = b.required(j, "kind", path, "joint")
         loop = {k: j[k] for k in LOOP_JOINT_KEYS if k in j}
+        if kind in ("universal", "cylindrical") and set(loop) <= {"axis2"}:
+            add_composite(b, path, j, name, kind)      # a tree joint of two parts
+            specs.append(dict(j))
+            continue
         if kind == "coupling" or loop or kind == "distance":
             add_loop_joint(b, path, j, name, kind, loop)
             specs.append(dict(j))
@@ -108,6 +112,22 @@ def add_joints(b):
         _check_added_joint(b, b.system.joints[name], path)
         specs.append(dict(j))
     return specs
+
+
+def add_composite(b, path, j, name, kind):
+    """A tree ``universal`` or ``cylindrical`` joint (``assembly.composite``)."""
+    child = b.required(j, "child", path, "joint")
+    parent = j.get("parent", GROUND)
+    _check_frames(b, path, parent, child)
+    axes = {k: (b.pvector(j[k], path + (k,)) if isinstance(j[k], list) else j[k])
+            for k in ("axis", "axis2") if k in j}
+    with b.engine(path):
+        b.system.add_joint(name, kind, parent, child,
+                           position=b.pvector(j.get("position"), path + ("position",)),
+                           orientation=_orientation(b, j.get("orientation"),
+                                                    path + ("orientation",)),
+                           coordinates=j.get("coordinates"), speeds=j.get("speeds"),
+                           drive=j.get("drive"), sequence=j.get("sequence"), **axes)
 
 
 def add_loop_joint(b, path, j, name, kind, loop):
