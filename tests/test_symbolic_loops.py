@@ -238,11 +238,15 @@ def test_parameters_stay_symbols(models):
 
 # ----------------------------------------------------------------------------- dynamics
 def _state(model, q0, u0, rng):
-    q = (q0 if q0 is not None else model.default_coordinates()) if model.nq else np.zeros(0)
-    if q0 is None:                    # the Python models close at their q of construction
-        q = _closing_q(model)
-    q = q + 0.05 * rng.normal(size=model.nq)
-    return model.project(q, rng.normal(size=model.nu), 0.0)
+    """A random state on the mechanism near its assembled (or constructed) one."""
+    q = q0 if q0 is not None else _closing_q(model)
+    u = rng.normal(size=model.nu)
+    for size in (0.05, 0.02, 0.005, 0.0):     # Bricard's loop closes only near its path
+        try:
+            return model.project(q + size * rng.normal(size=model.nq), u, 0.0)
+        except mb.SimulationError:
+            continue
+    raise AssertionError("no state on the mechanism")
 
 
 def _closing_q(model):
@@ -426,3 +430,19 @@ def test_json_constraints_read_back(models):
     lam = {names[n] for n in c["multipliers"]}
     acc = sympy.sympify(obj["accelerations"]["theta_dot"], locals=names)
     assert lam & acc.free_symbols
+
+
+@pytest.mark.parametrize("name", ("four_bar", "slider_crank"))
+def test_compare_numerically_takes_the_engines_multipliers(models, name):
+    """``compare_numerically`` on a closed mechanism, solved by Newton-Euler: M, f, the
+    accelerations and every reaction at the engine's multipliers, on the mechanism."""
+    from mbdyn.symbolic import compare_numerically
+    model, q0, u0 = models[name]
+    rng = np.random.default_rng(11)
+    states = [(*_state(model, q0, u0, rng), 0.0) for _ in range(3)]
+    d = derive(model, "newton-euler", solve=True)
+    err = compare_numerically(d, states, what=("mass_matrix", "forcing", "accelerations",
+                                               "reactions"))
+    assert max(err.values()) < 1e-10, err
+    with pytest.raises(mb.ModelError, match="multipliers"):
+        d.numeric("accelerations")(*states[0])

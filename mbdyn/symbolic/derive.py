@@ -167,9 +167,12 @@ class Derivation:
 
     # ------------------------------------------------------------------ numbers
     def numeric(self, what="mass_matrix"):
-        """A function ``(q, u, t=0, parameters=None)`` -> numpy array of ``mass_matrix``,
-        ``forcing``, ``accelerations`` (in ``speeds`` order) or ``reactions`` (joints in
-        model order, six components each) -- for checks, not for speed (see ``codegen``)."""
+        """A function ``(q, u, t=0, parameters=None, multipliers=None)`` -> numpy array of
+        ``mass_matrix``, ``forcing``, ``accelerations`` (in ``speeds`` order) or
+        ``reactions`` (joints in model order, six components each) -- for checks, not for
+        speed (see ``codegen``).  A closed mechanism's accelerations and reactions hold the
+        multipliers: give their values (``Model.multipliers``) in ``constraints.rows``
+        order."""
         import numpy as np
         from .evaluate import evaluate
         sym = self.walk.sym
@@ -186,13 +189,20 @@ class Derivation:
         shape = expr.shape
         flat = list(expr)
         params = dict(self.model.parameters)
+        lam = self.constraints.multipliers if self.constraints is not None else ()
 
-        def evaluate_at(q, u, t=0.0, parameters=None):
+        def evaluate_at(q, u, t=0.0, parameters=None, multipliers=None):
             vals = {sym.t: float(t)}
             vals.update({s: float(x) for s, x in zip(sym.q, q)})
             vals.update({s: float(x) for s, x in zip(sym.u, u)})
             p = dict(params, **(parameters or {}))
             vals.update({s: float(p[n]) for n, s in sym.params.items()})
+            if lam and multipliers is None and what in ("accelerations", "reactions"):
+                raise ModelError(f"model {self.model.name!r}: its {what} hold the loop "
+                                 "joints' multipliers; pass multipliers=... "
+                                 "(Model.multipliers(q, u, t)[1])")
+            vals.update({s: float(x) for s, x in zip(lam, multipliers if multipliers
+                                                     is not None else ())})
             return np.array(evaluate(flat, vals), dtype=float).reshape(shape).squeeze()
         return evaluate_at
 
