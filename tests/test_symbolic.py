@@ -205,7 +205,8 @@ def test_json_contract_and_parseable(dp_model):
     d = derive(dp_model, "newton-euler", solve=True)
     obj = json.loads(d.to_json())
     assert set(obj) == {"method", "coordinates", "speeds", "mass_matrix", "forcing",
-                        "accelerations", "reactions", "stats"}
+                        "accelerations", "reactions", "constraints", "stats"}
+    assert obj["constraints"] is None                   # a tree: no loop joints
     assert set(obj["stats"]) == {"derive_s", "operations", "operations_after_cse"}
     names = {n: sp.Symbol(n) for n in d.names()}
     plain = {v: sp.Symbol(k) for k, v in d.names().items()}

@@ -11,7 +11,9 @@ frame, velocities and accelerations of the centres of mass, masses, momenta, for
 reactions or Jacobians or energies, then the equations); ``--solve`` solves them for the
 accelerations (and, by Newton-Euler, for every reaction component).  ``--format json`` prints
 one object (see ``mbdyn.symbolic.report``) whose expression strings ``sympy.sympify`` reads
-back with the model's names as symbols.
+back with the model's names as symbols.  A model with loop joints gets its constraint
+equations ``phi(q, t) = 0``, their Jacobian, ``gamma`` and the equations with the
+multipliers ``M u' = f + G^T lambda`` in every format (``mbdyn.symbolic.loops``).
 """
 from __future__ import annotations
 

@@ -10,12 +10,12 @@ frame; a ``universal`` joint's second axis ``axis2`` is in the child's joint fra
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import ModelError
-from .values import _vector3, numeric, parse_axis, parse_orientation
+from .values import _vector3, has_symbols, numeric, parse_axis, parse_orientation
 
 #: kinds that can close a loop, with the number of equations each writes
 LOOP_KINDS = {"revolute": 5, "prismatic": 5, "spherical": 3, "fixed": 6, "universal": 4,
@@ -28,7 +28,8 @@ AXIAL = ("revolute", "prismatic", "universal", "cylindrical")
 class LoopJoint:
     """A constraint closing a loop; see ``System.add_joint``.  ``follower``, ``leader``,
     ``ratio``, ``offset`` are a coupling's (``q_follower = ratio q_leader + offset``);
-    ``length`` a distance's."""
+    ``length`` a distance's.  ``symbolic`` keeps the values given as sympy expressions of
+    the parameters (for ``mbdyn.symbolic``), by keyword."""
     name: str
     kind: str
     parent: str | None
@@ -44,6 +45,7 @@ class LoopJoint:
     leader: str | None = None
     ratio: float = 1.0
     offset: float = 0.0
+    symbolic: dict = field(default_factory=dict, compare=False, repr=False)
 
     @property
     def equations(self):
@@ -57,13 +59,17 @@ def make_loop_joint(name, kind, parent, child, *, position=(0, 0, 0), orientatio
     """Validate and build a ``LoopJoint``."""
     element = f"joint {name!r}"
     parameters = parameters or {}
+    raw = {"position": position, "orientation": orientation, "child_position": child_position,
+           "child_orientation": child_orientation, "axis": axis, "axis2": axis2,
+           "length": length, "ratio": ratio, "offset": offset}
+    symbolic = {k: v for k, v in raw.items() if not isinstance(v, str) and has_symbols(v)}
     if kind not in LOOP_KINDS:
         raise ModelError(f"{element}: a {kind!r} joint cannot close a loop; use one of "
                          + ", ".join(repr(k) for k in LOOP_KINDS))
     num = lambda value, what: numeric(value, parameters, element, what)  # noqa: E731
     if kind == "coupling":
         return _make_coupling(name, follower, leader, num(ratio, "ratio"),
-                              num(offset, "offset"))
+                              num(offset, "offset"), symbolic)
     if child == parent:
         raise ModelError(f"{element}: parent and child are both {child!r}; a loop joint "
                          "joins two different bodies")
@@ -106,10 +112,10 @@ def make_loop_joint(name, kind, parent, child, *, position=(0, 0, 0), orientatio
     elif length is not None:
         raise ModelError(f"{element}: only a distance constraint takes length")
     return LoopJoint(name, kind, parent, child, position, C, child_position, Cc, axis, axis2,
-                     length=float(length or 0.0))
+                     length=float(length or 0.0), symbolic=symbolic)
 
 
-def _make_coupling(name, follower, leader, ratio, offset):
+def _make_coupling(name, follower, leader, ratio, offset, symbolic=None):
     """A coupling ``q_follower = ratio q_leader + offset`` between two tree joints."""
     element = f"joint {name!r}"
     for key, value in (("follower", follower), ("leader", leader)):
@@ -123,7 +129,7 @@ def _make_coupling(name, follower, leader, ratio, offset):
     return LoopJoint(name, "coupling", None, None, np.zeros(3), eye, np.zeros(3), eye,
                      np.zeros(3), np.zeros(3), follower=follower, leader=leader,
                      ratio=_scalar(ratio, element, "ratio"),
-                     offset=_scalar(offset, element, "offset"))
+                     offset=_scalar(offset, element, "offset"), symbolic=dict(symbolic or {}))
 
 
 def _orientation(value, num):

@@ -365,6 +365,12 @@ def compiled_rhs(model, *, rebuild=False):
     compiled on first use, then cached (see the module docstring)."""
     from .derive import _as_model, derive
     model = _as_model(model)
+    if getattr(model, "loop_joints", ()):
+        raise ModelError(f"model {model.name!r}: its loop joints ({', '.join(model.loop_joints)}) "
+                         "close kinematic loops, and the generated right-hand side solves "
+                         "M u' = f of the tree only; use a numeric method (method='auto'); "
+                         "mb.derive writes the constraint equations and the equations with "
+                         "multipliers")
     if not rebuild and model in _MEMORY:
         return _MEMORY[model]
     key = model_signature(model)

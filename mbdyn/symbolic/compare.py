@@ -60,25 +60,29 @@ def compare_numerically(derivation, states=None, what=("mass_matrix", "forcing")
     """Largest relative difference between the derivation and the numeric engine over
     ``states`` (default: five random ones) for each of ``what``: ``mass_matrix``,
     ``forcing``, ``accelerations`` and ``reactions`` (world components, as
-    ``Model.reactions``)."""
+    ``Model.reactions``).  A closed mechanism's accelerations and reactions are taken at
+    the engine's multipliers (``Model.multipliers``; give states on the mechanism)."""
     model = derivation.model
     states = random_states(model) if states is None else states
+    loops = derivation.constraints is not None
     out = {}
     for name in what:
         worst = 0.0
         fn = derivation.numeric(name)
         for q, u, t in states:
+            lam = model.multipliers(q, u, t)[1] if loops and name in (
+                "accelerations", "reactions") else None
             if name == "mass_matrix":
                 a, b = fn(q, u, t), model.mass_matrix(q, t)
             elif name == "forcing":
                 a, b = fn(q, u, t), model.forcing(q, u, t)
             elif name == "accelerations":
-                a, b = fn(q, u, t), model.forward_dynamics(q, u, t)
+                a, b = fn(q, u, t, multipliers=lam), model.forward_dynamics(q, u, t)
             else:
                 ref = model.reactions(q, u, t)
                 kin = model.kinematics(q, u, t=t)
                 a, b = [], []
-                values = np.asarray(fn(q, u, t), dtype=float).reshape(-1, 6)
+                values = np.asarray(fn(q, u, t, multipliers=lam), dtype=float).reshape(-1, 6)
                 for joint, vals in zip(model.joints, values):
                     i = model.frame_index(model.joint(joint).child)
                     R = np.eye(3) if derivation.frames == "inertial" else kin.R[i]

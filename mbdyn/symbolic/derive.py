@@ -4,12 +4,19 @@
     d.mass_matrix, d.forcing          # M(q), f(q, u, t) of M u' = f (sympy matrices)
     d.accelerations                   # {speed name: expression of u'} (solve=True)
     d.reactions                       # {joint: [Fx, Fy, Fz, Mx, My, Mz]} (newton-euler, solve)
+    d.constraints                     # closed loops: phi, Phi_q, G, gamma, lambda (else None)
+    d.constrained_equations()         # M u' = f + G^T lambda and G u' = gamma, as sympy.Eq
     d.steps()                         # the derivation, step by step, as the textbook does it
     print(d.to_text(steps=True))      # or to_latex(), to_markdown(), to_dict() / to_json()
 
 Reactions are the force and the moment the parent exerts on the child at the child frame's
 origin, in the child frame's own components (``frames="own"``, the default) or in inertial
 components (``frames="inertial"``).
+
+A model with loop joints (``mbdyn.symbolic.loops``): ``M`` and ``f`` are the tree's, and the
+loops add ``G^T lambda`` to ``f`` (``M u' = f + G^T lambda``, ``G u' = gamma``); by
+Newton-Euler the multipliers' forces and moments act on the bodies (the reactions include
+them); ``solve=True`` gives the accelerations in terms of the multipliers.
 """
 from __future__ import annotations
 
@@ -21,14 +28,15 @@ import sympy
 
 from .. import limits
 from ..errors import ModelError
+from .loops import add_multiplier_loads, loop_equations
 from .methods import FORMULATIONS, METHODS
-from .simplify import (MODES, finish_matrix, operations, operations_after_cse,
-                       tree_size)
+from .simplify import (MODES, diff, finish_matrix, operations, operations_after_cse,
+                       replace_shared, tree_size)
+from .solve import solve_linear, substitute_rates
+from .walk import FRAMES, Walk, too_large
 
 #: results (M and f together) up to this many nodes get the final tidying (``finish``)
 FINISH_BUDGET = 5000
-from .solve import solve_linear, substitute_rates
-from .walk import FRAMES, Walk, too_large
 
 
 def _as_model(model_or_system):
@@ -75,6 +83,7 @@ class Derivation:
     reactions: dict | None = None
     denominator: sympy.Expr | None = None
     stats: dict = field(default_factory=dict)
+    constraints: object = None          # loops.LoopEquations of a closed mechanism
 
     # ------------------------------------------------------------------ basic views
     @property
@@ -105,9 +114,31 @@ class Derivation:
         lhs = self.mass_matrix * ud
         return [sympy.Eq(lhs[k], self.forcing[k]) for k in range(len(ud))]
 
+    def constrained_equations(self):
+        """A closed mechanism's equations with the multipliers, as ``sympy.Eq``: the rows
+        of ``M u' = f + G^T lambda`` (by Lagrange ``d/dt dL/dq' - dL/dq = Q + Phi_q^T
+        lambda``: left ``M q'' - f + Q``, right ``Q + Phi_q^T lambda``), then those of
+        ``G u' = gamma``.  A tree's are ``equations_of_motion()``."""
+        c = self.constraints
+        if c is None:
+            return self.equations_of_motion()
+        ud = sympy.Matrix(self.rates)
+        lhs = self.mass_matrix * ud
+        rhs = self.forcing + c.constraint_forces()
+        if self.method == "lagrange":
+            Q = self.equations.details["generalized_forces"]
+            lhs, rhs = lhs - self.forcing + Q, Q + c.constraint_forces()
+        acc = c.G * ud
+        return ([sympy.Eq(lhs[k], rhs[k], evaluate=False) for k in range(len(ud))]
+                + [sympy.Eq(acc[k], c.gamma[k], evaluate=False) for k in range(len(c.rows))])
+
     def names(self):
-        """``{name: Symbol}`` of every parameter, coordinate, speed, rate and ``t``."""
-        return dict(self.walk.sym.table)
+        """``{name: Symbol}`` of every parameter, coordinate, speed, rate and ``t`` (and
+        multiplier, for a closed mechanism)."""
+        out = dict(self.walk.sym.table)
+        if self.constraints is not None:
+            out.update((s.name, s) for s in self.constraints.multipliers)
+        return out
 
     def subs(self, values):
         """A copy with ``values`` substituted in the equations (and solutions), keys given
@@ -131,13 +162,17 @@ class Derivation:
             {k: sub(v) for k, v in self.accelerations.items()},
             reactions=None if self.reactions is None else
             {k: (sub(v) if not isinstance(v, (tuple, list)) else type(v)(sub(x) for x in v))
-             for k, v in self.reactions.items()})
+             for k, v in self.reactions.items()},
+            constraints=None if self.constraints is None else self.constraints.subs(mapping))
 
     # ------------------------------------------------------------------ numbers
     def numeric(self, what="mass_matrix"):
-        """A function ``(q, u, t=0, parameters=None)`` -> numpy array of ``mass_matrix``,
-        ``forcing``, ``accelerations`` (in ``speeds`` order) or ``reactions`` (joints in
-        model order, six components each) -- for checks, not for speed (see ``codegen``)."""
+        """A function ``(q, u, t=0, parameters=None, multipliers=None)`` -> numpy array of
+        ``mass_matrix``, ``forcing``, ``accelerations`` (in ``speeds`` order) or
+        ``reactions`` (joints in model order, six components each) -- for checks, not for
+        speed (see ``codegen``).  A closed mechanism's accelerations and reactions hold the
+        multipliers: give their values (``Model.multipliers``) in ``constraints.rows``
+        order."""
         import numpy as np
         from .evaluate import evaluate
         sym = self.walk.sym
@@ -154,13 +189,20 @@ class Derivation:
         shape = expr.shape
         flat = list(expr)
         params = dict(self.model.parameters)
+        lam = self.constraints.multipliers if self.constraints is not None else ()
 
-        def evaluate_at(q, u, t=0.0, parameters=None):
+        def evaluate_at(q, u, t=0.0, parameters=None, multipliers=None):
             vals = {sym.t: float(t)}
             vals.update({s: float(x) for s, x in zip(sym.q, q)})
             vals.update({s: float(x) for s, x in zip(sym.u, u)})
             p = dict(params, **(parameters or {}))
             vals.update({s: float(p[n]) for n, s in sym.params.items()})
+            if lam and multipliers is None and what in ("accelerations", "reactions"):
+                raise ModelError(f"model {self.model.name!r}: its {what} hold the loop "
+                                 "joints' multipliers; pass multipliers=... "
+                                 "(Model.multipliers(q, u, t)[1])")
+            vals.update({s: float(x) for s, x in zip(lam, multipliers if multipliers
+                                                     is not None else ())})
             return np.array(evaluate(flat, vals), dtype=float).reshape(shape).squeeze()
         return evaluate_at
 
@@ -230,7 +272,7 @@ def derive(model_or_system, method="jourdain", *, frames="own", simplify="compac
         ", or use the jourdain method without solving (the shortest form)"
     walk = Walk(model, frames=frames, simplify=simplify, max_nodes=max_nodes)
     t_walk = time.perf_counter()
-    eq = FORMULATIONS[method](walk)
+    eq, loops = _formulate(walk, method)
     size = sum(tree_size(e) for e in eq.M) + sum(tree_size(e) for e in eq.f)
     if max_nodes is not None and size > max_nodes:
         raise too_large(model, f"M and f by {method}", size, max_nodes, shorter)
@@ -239,26 +281,17 @@ def derive(model_or_system, method="jourdain", *, frames="own", simplify="compac
         f = finish_matrix(eq.f, simplify, units=walk.units)
     else:                                   # large ones stay in the walk's nested form
         M, f = eq.M, eq.f
+    if loops is not None:
+        loops.tidy(simplify, walk.units, FINISH_BUDGET)
+        if max_nodes is not None:           # the constraints are printed with M and f
+            size = loops.size()
+            if size > max_nodes:
+                raise too_large(model, "the constraint equations, their Jacobian and gamma",
+                                size, max_nodes)
     t_eq = time.perf_counter()
-    d = Derivation(model, method, frames, simplify, walk, eq, M, f)
+    d = Derivation(model, method, frames, simplify, walk, eq, M, f, constraints=loops)
     if solve:
-        nums, den = solve_linear(M, f, simplify, walk.units)
-        d.denominator = den
-        d.accelerations = {s: _quotient(n, den) for s, n in zip(model.speeds, nums)}
-        if method == "newton-euler":
-            d.reactions = {}
-            for joint in model.joints:
-                AF, bF, AM, bM = eq.details["reactions"].linear(joint)
-                comps = []
-                for A, b in ((AF, bF), (AM, bM)):
-                    for r in range(3):
-                        if b[r] == 0 and all(a == 0 for a in A[r, :]):
-                            comps.append(sympy.Integer(0))
-                            continue
-                        num = substitute_rates(A[r, :], b[r], nums, den, simplify,
-                                               walk.units)
-                        comps.append(_quotient(num, den))
-                d.reactions[joint] = comps
+        _solve(d, eq, loops, simplify, walk.units)
         solved = sum(tree_size(e) for e in d.accelerations.values()) + sum(
             tree_size(e) for comps in (d.reactions or {}).values() for e in comps)
         if max_nodes is not None and solved > max_nodes:
@@ -273,3 +306,50 @@ def derive(model_or_system, method="jourdain", *, frames="own", simplify="compac
             d.stats["operations"] = operations(M) + operations(f)
         d.stats["operations_after_cse"] = operations_after_cse([M, f])
     return d
+
+
+def _formulate(walk, method):
+    """``(equations, loops)``: the method's ``M`` and ``f``, and a closed mechanism's
+    ``LoopEquations`` (None for a tree); by Newton-Euler the multipliers' forces act on the
+    bodies (their reactions include them), then leave ``f``."""
+    loops = loop_equations(walk)
+    if loops is not None and method == "newton-euler":
+        add_multiplier_loads(walk, loops)
+    eq = FORMULATIONS[method](walk)
+    if loops is not None and method == "newton-euler":
+        _split_multipliers(eq, loops)
+    return eq, loops
+
+
+def _solve(d, eq, loops, simplify, units):
+    """``d.accelerations`` (in terms of the multipliers of a closed mechanism) and, by
+    Newton-Euler, ``d.reactions``, in closed form over the common denominator."""
+    M, f = d.mass_matrix, d.forcing
+    rhs = f if loops is None else f + loops.constraint_forces()
+    nums, den = solve_linear(M, rhs, simplify, units)
+    d.denominator = den
+    d.accelerations = {s: _quotient(n, den) for s, n in zip(d.model.speeds, nums)}
+    if d.method != "newton-euler":
+        return
+    d.reactions = {}
+    for joint in d.model.joints:
+        AF, bF, AM, bM = eq.details["reactions"].linear(joint)
+        comps = []
+        for A, b in ((AF, bF), (AM, bM)):
+            for r in range(3):
+                if b[r] == 0 and all(a == 0 for a in A[r, :]):
+                    comps.append(sympy.Integer(0))
+                    continue
+                num = substitute_rates(A[r, :], b[r], nums, den, simplify, units)
+                comps.append(_quotient(num, den))
+        d.reactions[joint] = comps
+
+
+def _split_multipliers(eq, loops):
+    """Newton-Euler with the multipliers' loads on the bodies: ``f`` without them, and
+    their generalized forces (``G^T`` as Newton-Euler projects them) in
+    ``eq.details["constraint_forces"]``."""
+    lam = loops.multipliers
+    eq.details["constraint_forces"] = sympy.Matrix(
+        eq.f.rows, len(lam), lambda r, c: diff(eq.f[r], lam[c]))
+    eq.f = replace_shared(eq.f, {x: sympy.Integer(0) for x in lam}).applyfunc(loops.walk.s)

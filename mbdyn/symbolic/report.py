@@ -5,7 +5,12 @@ JSON (``mbdyn eom --format json``) is one object::
     {"method": str, "coordinates": [str], "speeds": [str], "mass_matrix": [[str]],
      "forcing": [str], "accelerations": {speed: str} | null,
      "reactions": {joint: [Fx, Fy, Fz, Mx, My, Mz]} | null,
+     "constraints": {"rows": [str], "joints": [str], "multipliers": [str], "phi": [str],
+                     "jacobian": [[str]], "G": [[str]], "phi_t": [str], "gamma": [str],
+                     "constraint_forces": [str], "equations": str} | null,
      "stats": {"derive_s": float, "operations": int, "operations_after_cse": int}}
+
+(``constraints``: a closed mechanism's loops, ``mbdyn.symbolic.loop_report``.)
 
 (plus ``"steps"`` when asked for).  Every expression string is ``str()`` of a sympy
 expression: ``sympy.sympify(s, locals={name: Symbol(name) for name in names})`` reads it back,
@@ -15,6 +20,7 @@ from __future__ import annotations
 
 import sympy
 
+from . import loop_report
 from .steps import Step
 
 
@@ -87,7 +93,7 @@ def as_text(d, steps=False):
                 out.append(f"  {e.label} = {_text_value(e.value)}{note}")
             out.append("")
     else:
-        out.append("M(q) u' = f(q, u, t)")
+        out.append(loop_report.equations_title(d))
         out.append("")
         for r in range(d.mass_matrix.rows):
             for c in range(d.mass_matrix.cols):
@@ -97,7 +103,11 @@ def as_text(d, steps=False):
         for r, s in enumerate(d.speeds):
             out.append(f"  f[{s}] = {_str(d.forcing[r])}")
         out.append("")
+        out.extend(loop_report.text_lines(d, _str))
         if d.accelerations is not None:
+            if d.constraints is not None:
+                out.append("Accelerations in terms of the multipliers (u' = M^-1 (f + G^T "
+                           "lambda))")
             for s, e in d.accelerations.items():
                 rate = d.walk.sym.ud[d.model.speed_index(s)]
                 out.append(f"  {rate.name} = {_str(e)}")
@@ -137,6 +147,8 @@ def _latex_body(d, steps, heading, math_open, math_close, para):
         out.append(heading("Equations of motion"))
         out.append(math_open + "M = " + _latex(d.mass_matrix, names) + math_close)
         out.append(math_open + "f = " + _latex(d.forcing, names) + math_close)
+        out.extend(loop_report.latex_parts(d, names, _latex, heading, math_open, math_close,
+                                           para))
         if d.accelerations is not None:
             out.append(heading("Accelerations"))
             for s, e in d.accelerations.items():
@@ -206,6 +218,7 @@ def as_dict(d, steps=False):
                           else {s: _str(e) for s, e in d.accelerations.items()}),
         "reactions": (None if d.reactions is None
                       else {j: [_str(e) for e in comps] for j, comps in d.reactions.items()}),
+        "constraints": loop_report.as_dict(d, _str),
         "stats": {"derive_s": float(d.stats.get("derive_s", 0.0)),
                   "operations": int(d.stats.get("operations", -1)),
                   "operations_after_cse": int(d.stats.get("operations_after_cse", -1))},

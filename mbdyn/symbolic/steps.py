@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import sympy
 
+from .loop_steps import constraint_entries, multiplier_step
 from .method_steps import _jourdain_steps, _lagrange_steps, _newton_euler_steps
 from .method_steps import newton_euler_equations, reaction_symbols  # noqa: F401 (their home)
 from .step_record import LATEX_NAMES, Entry, Step  # noqa: F401 (report.py reads them here)
@@ -42,12 +43,15 @@ def build_steps(d):
     the method's own steps, the equations of motion and, when solved, the solution."""
     c = _Labels(d)
     steps = [step(c) for step in KINEMATIC_STEPS]
+    constraint_entries(steps[2], d)         # step 3: a closed mechanism's constraints
     if d.method == "newton-euler":
         steps.extend(_newton_euler_steps(d, c.fl, c.basis))
     elif d.method == "jourdain":
         steps.extend(_jourdain_steps(d, c.fl, c.basis))
     else:
         steps.extend(_lagrange_steps(d, c.fl, c.basis))
+    if d.constraints is not None:
+        steps.append(multiplier_step(d))
     steps.append(_equations_step(d, c))
     if d.accelerations is not None:
         steps.append(_solution_step(d, c))
@@ -203,12 +207,16 @@ KINEMATIC_STEPS = (_frames_step, _transformations_step, _positions_step, _rotati
 def _equations_step(d, c):
     """The equations of motion ``M(q) u' = f`` and the kinematic equations."""
     walk = c.walk
+    loops = d.constraints is not None
     st = Step("13" if d.method != "newton-euler" else "12",
-              "Equations of motion M(q) u' = f(q, u, t)",
+              "Equations of motion M(q) u' = f(q, u, t)" + (" + G^T lambda, G u' = gamma"
+                                                             if loops else ""),
               f"By {d.method}; speeds u = ({', '.join(d.speeds)}), rates u' = "
               f"({', '.join(s.name for s in d.rates)}).")
     st.add("M", "M", d.mass_matrix)
     st.add("f", "f", d.forcing)
+    if loops:
+        _multiplier_rows(st, d)
     nontrivial = {q: r for q, r in walk.qdot.items()
                   if not (isinstance(r, sympy.Symbol) and r.name.startswith(q.name))}
     if nontrivial:
@@ -236,3 +244,27 @@ def _solution_step(d, c):
             st.add(f"{b[0]} M ({joint}, moment)", f"{{}}^{{{b[1]}}}M_{{\\text{{{joint}}}}}",
                    sympy.Matrix(comps[3:]))
     return st
+
+
+def _multiplier_rows(st, d):
+    """The equations with the multipliers, in two blocks: one row a speed, then the
+    acceleration constraints (rows identically ``0 = 0`` named, not written)."""
+    eqs = d.constrained_equations()
+    n, rows = len(d.speeds), d.constraints.rows
+    if d.method == "lagrange":
+        st.add("d/dt dL/dq' - dL/dq = Q + Phi_q^T lambda",
+               r"\frac{d}{dt}\frac{\partial L}{\partial \dot q} - \frac{\partial L}"
+               r"{\partial q} = Q + \Phi_q^T \lambda", _block(eqs[:n]))
+    else:
+        st.add("M u' = f + G^T lambda", r"M \dot u = f + G^T \lambda", _block(eqs[:n]))
+    kept = [e for e in eqs[n:] if not (e.lhs == 0 and e.rhs == 0)]
+    zero = [rows[k] for k, e in enumerate(eqs[n:]) if e.lhs == 0 and e.rhs == 0]
+    if kept:
+        st.add("G u' = gamma", r"G \dot u = \gamma", _block(kept))
+    if zero:
+        st.add("G u' = gamma", r"G \dot u = \gamma", "0 = 0 in rows " + ", ".join(zero)
+               + " (identically satisfied here)")
+
+
+def _block(eqs):
+    return (sympy.Matrix([e.lhs for e in eqs]), sympy.Matrix([e.rhs for e in eqs]))
