@@ -63,11 +63,8 @@ def test_external_dtd_is_not_fetched(tmp_path):
     p.write_text('<?xml version="1.0"?><!DOCTYPE robot SYSTEM "http://127.0.0.1:9/x.dtd">'
                  + f'<robot name="r">{ARM}</robot>')
     start = time.perf_counter()
-    try:
-        scene = mb.load_model(p)          # expat never fetches it: read as without
-        assert scene.model.coordinates == ("q",)
-    except ModelFileError as exc:         # or refused: either way nothing is fetched
-        assert "external" in str(exc)
+    scene = mb.load_model(p)              # never fetched (port 9 would not answer)
+    assert scene.model.coordinates == ("q",)
     assert time.perf_counter() - start < 5
 
 
