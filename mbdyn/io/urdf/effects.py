@@ -80,9 +80,9 @@ def stop_law(lower, upper, k, c):
     ``max(k (x - upper) + c v, 0)`` above, ``min(k (x - lower) + c v, 0)`` below."""
     pieces = []
     if math.isfinite(upper):
-        pieces.append((sympy.Max(k * (X - upper) + c * V, 0), X > upper))
+        pieces.append((sympy.Max(k * (X - upper) + c * V, 0, evaluate=False), X > upper))
     if math.isfinite(lower):
-        pieces.append((sympy.Min(k * (X - lower) + c * V, 0), X < lower))
+        pieces.append((sympy.Min(k * (X - lower) + c * V, 0, evaluate=False), X < lower))
     return sympy.Piecewise(*pieces, (0, True))
 
 
