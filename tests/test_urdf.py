@@ -406,3 +406,11 @@ def test_forward_dynamics_against_a_system_built_by_hand(name):
         assert np.allclose(ours.forward_dynamics(q, u), expected, rtol=1e-12,
                            atol=1e-12 * np.abs(expected).max())
         assert np.allclose(ours.mass_matrix(q), hand.mass_matrix(q), rtol=1e-13, atol=1e-15)
+
+
+def test_fixed_joints_keep_any_name_without_a_warning(tmp_path):
+    p = urdf(tmp_path, link("base") + link("tip") + joint("tool-0 mount", "fixed", "base", "tip"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        model = mb.load_model(p).model
+    assert model.joint("tool-0 mount").kind == "fixed"

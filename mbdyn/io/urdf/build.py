@@ -151,7 +151,7 @@ class RobotBuilder:
 
     def joint(self, joint):
         kind = KINDS[joint.type]
-        c = self.name_for(joint)
+        c = self.name_for(joint) if kind != "fixed" else None      # no coordinates
         parent, child = self.frame(joint.parent), joint.child
         place = dict(position=list(joint.xyz), orientation=rpy_matrix(joint.rpy).tolist())
         add = self.system.add_joint

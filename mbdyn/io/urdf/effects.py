@@ -41,6 +41,8 @@ def add_effects(b, order):
             b.warnings.append(f"{b.reader.file}: joint {joint.name!r}: <dynamics> of a "
                               f"{joint.type} joint is not used (only 1-DoF joints take it)")
             continue
+        if not one_dof:
+            continue
         c = b.coordinate[joint.name]
         if dyn.get("damping", 0.0) < 0 or dyn.get("friction", 0.0) < 0:
             raise b.error(f"joint {joint.name!r}", "<dynamics> damping and friction must "

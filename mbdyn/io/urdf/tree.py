@@ -49,17 +49,7 @@ def tree_order(reader, robot):
                                "tree (close a loop in a TOML wrapper with a loop joint)")
         parent_joint[joint.child] = joint
     roots = [n for n in robot.links if n not in parent_joint]
-    for name in robot.links:            # a link whose ancestors come back to it
-        seen, link = [name], name
-        while link in parent_joint:
-            link = parent_joint[link].parent
-            if link == name:
-                cycle = " -> ".join(reversed(seen + [name]))
-                raise reader.error(f"link {name!r}", f"the joints form a cycle ({cycle}); "
-                                   "a URDF is a tree")
-            if link in seen:
-                break
-            seen.append(link)
+    _check_cycles(reader, robot, parent_joint)
     if len(roots) != 1:
         raise reader.error("", f"has {len(roots)} root links ({', '.join(roots)}): links "
                            "that are no joint's child; a URDF is one tree -- join them")
@@ -67,6 +57,25 @@ def tree_order(reader, robot):
     for joint in robot.joints.values():
         children[joint.parent].append(joint)
     return roots[0], _depth_first(roots[0], children)
+
+
+def _check_cycles(reader, robot, parent_joint):
+    """A link whose ancestors come back to it is an error naming the cycle.  Each link is
+    walked once (O(n)): a walk stops at a link an earlier walk has cleared."""
+    cleared = set()
+    for name in robot.links:
+        path, on_path, link = [], set(), name
+        while link not in cleared:
+            if link in on_path:
+                cycle = path[path.index(link):] + [link]
+                raise reader.error(f"link {link!r}", "the joints form a cycle ("
+                                   + " -> ".join(reversed(cycle)) + "); a URDF is a tree")
+            path.append(link)
+            on_path.add(link)
+            if link not in parent_joint:
+                break
+            link = parent_joint[link].parent
+        cleared.update(path)
 
 
 def _depth_first(root, children):
