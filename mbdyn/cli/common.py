@@ -58,7 +58,9 @@ def add_command(subparsers, name, description, func, model_arguments=True):
 
 def add_model_arguments(parser):
     """``MODEL [--case NAME] [--set PATH=VALUE ...]``."""
-    parser.add_argument("model", metavar="MODEL", help="model file (.toml)")
+    parser.add_argument("model", metavar="MODEL", help="model file (.toml) or URDF robot "
+                                                        "(.urdf)")
+    add_urdf_arguments(parser)
     parser.add_argument("--case", metavar="NAME",
                         help="apply the file's [cases.NAME] (default: model.default_case)")
     parser.add_argument("--set", dest="overrides", metavar="PATH=VALUE", action="append",
@@ -70,6 +72,24 @@ def add_model_arguments(parser):
                         help="switch effects off (-name) or on (+name) after the file's "
                              "[effects], e.g. --effects=-gravity,-bearing_left; names: gravity, "
                              "gyroscopic, every load and force element (mbdyn info lists them)")
+
+
+def add_urdf_arguments(parser):
+    """``--floating``, ``--accept-inertia``: a URDF robot's options (docs/urdf.md),
+    shorthands of ``--set model.floating=true`` and ``--set model.accept_inertia=true``."""
+    parser.add_argument("--floating", action="store_true",
+                        help="URDF: the base hangs from the ground by a free joint 'root' "
+                             "(default: fixed)")
+    parser.add_argument("--accept-inertia", action="store_true",
+                        help="URDF: accept inertias no body can have (a negative principal "
+                             "moment set to 0, a broken triangle inequality), with a warning")
+
+
+def urdf_overrides(args):
+    """``(path, value, origin)`` of ``--floating`` and ``--accept-inertia``, if given."""
+    return [(f"model.{key}", True, flag) for key, flag in
+            (("floating", "--floating"), ("accept_inertia", "--accept-inertia"))
+            if getattr(args, key, False)]
 
 
 #: the simulation options of every command that runs a model (run, plot, animate, sweep,
@@ -123,7 +143,7 @@ def _flag_values(args, flags):
 def overrides(args, flags=()):
     """``--set`` texts, then the ``(path, flag)`` options given (e.g. ``--dt``), as
     ``(path, value, origin)`` triples for ``load_model``."""
-    return list(args.overrides) + _flag_values(args, flags)
+    return list(args.overrides) + _flag_values(args, flags) + urdf_overrides(args)
 
 
 def load(args, flags=None, record_warnings=False):

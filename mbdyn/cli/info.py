@@ -77,6 +77,7 @@ def describe(scene):
         "outputs": outputs_spec(scene),
         "warnings": list(scene.warnings),
         "loops": describe_loops(scene) if model.has_loops else None,
+        "urdf": scene.urdf,
     }
 
 
@@ -116,7 +117,7 @@ def info(args):
         sys.stdout.write(json.dumps(d) + "\n")
         return 0
     w = sys.stdout.write
-    for section in (_model, _bodies, _joints, _loops, _states, _loads, _run_settings,
+    for section in (_model, _urdf, _bodies, _joints, _loops, _states, _loads, _run_settings,
                     _outputs):
         section(d, w)
     return 0
@@ -134,6 +135,47 @@ def _model(d, w):
         w("parameters   " + ", ".join(f"{k} = {fmt(v)}" for k, v in d["parameters"].items())
           + "\n")
     w(f"gravity      {_text(d['gravity'])}\n")
+
+
+def _urdf(d, w):
+    """What a URDF robot held beyond bodies and joints: massless links, limits, stops,
+    dampers, friction, mimics, transmissions, renamed coordinates, tags not used."""
+    u = d.get("urdf")
+    if not u:
+        return
+    base = {"world": "the root link 'world' is the ground",
+            "fixed": "base fixed to the ground (joint 'root')",
+            "floating": "base floating (free joint 'root')"}[u["base"]]
+    w(f"urdf         {u['file']}: robot {u['robot']}, root link {u['root']}; {base}\n")
+    if u["massless"]:
+        w(f"  massless links (no <inertial>): {', '.join(u['massless'])}\n")
+    for j in u["joints"]:
+        parts = [f"{k} {_text(v)}" for k, v in j.get("limit", {}).items()]
+        parts += [f"{k} {_text(v)}" for k, v in j.get("dynamics", {}).items()]
+        if "mimic" in j:
+            m = j["mimic"]
+            parts.append(f"mimics {m['joint']} (x {fmt(m.get('multiplier', 1.0))} + "
+                         f"{fmt(m.get('offset', 0.0))})")
+        if parts:
+            w(f"  {j['name']:<14} {j['type']}: {', '.join(parts)}\n")
+    for name, st in u["stops"].items():
+        w(f"  stop {name}: {st['joint']} in [{fmt(st['lower'])}, {fmt(st['upper'])}], "
+          f"stiffness {fmt(st['stiffness'])}, damping {fmt(st['damping'])}"
+          f"{'' if d['effects'].get(name, True) else '  [off]'}\n")
+    for what, names in u["effects"].items():
+        if what != "limit":
+            w(f"  {what}: {', '.join(names)}\n")
+    for t in u["transmissions"]:
+        acts = ", ".join(f"{a['name']}" + (f" (reduction {a['reduction']})" if a["reduction"]
+                                           else "") for a in t["actuators"])
+        w(f"  transmission {t['name']} ({t['type'] or 'no type'}): joints "
+          f"{', '.join(j['name'] for j in t['joints']) or '(none)'}; actuators "
+          f"{acts or '(none)'} -- read, not modelled\n")
+    if u["renamed"]:
+        w("  coordinates renamed: " + ", ".join(f"{a} -> {b}" for a, b in u["renamed"].items())
+          + "\n")
+    if u["not_used"]:
+        w("  not used: " + ", ".join(f"<{k}> ({n})" for k, n in u["not_used"].items()) + "\n")
 
 
 def _bodies(d, w):

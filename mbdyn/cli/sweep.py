@@ -22,10 +22,12 @@ from ..viz.sweep_plots import FORMATS as PICTURES
 from .common import (
     add_command,
     add_simulation_arguments,
+    add_urdf_arguments,
     fmt,
     positive,
     positive_int,
     simulation_overrides,
+    urdf_overrides,
 )
 
 
@@ -35,7 +37,8 @@ def register(subparsers):
                     "keep quantities of each run in a table (CSV).  Ranges: START:STOP:N "
                     "(N points, ends included), START:STOP:N:log, or a list [a, b, \"pi/4\"].",
                     run, model_arguments=False)
-    p.add_argument("model", metavar="MODEL", help="model file (.toml)")
+    p.add_argument("model", metavar="MODEL", help="model file (.toml) or URDF robot (.urdf)")
+    add_urdf_arguments(p)
     p.add_argument("--grid", metavar="PATH=VALUES", action="append", default=[],
                    help="one axis of the grid, e.g. parameters.Mz=-0.03:-0.001:8 or "
                         "initial.theta=[0.1, 0.2] (repeatable: every combination)")
@@ -129,7 +132,8 @@ def run(args):
         raise ModelError("--plot needs --out FILE or --plot-file PNG")
     _check_outputs(args.out, plot_file)
     result = sweep(args.model, grid, tuple(args.quantities or DEFAULT_QUANTITIES),
-                   cases=args.case, fixed={**_fixed(args.fixed), **simulation_overrides(args)},
+                   cases=args.case, fixed={**_fixed(args.fixed), **simulation_overrides(args),
+                                           **{p: v for p, v, _ in urdf_overrides(args)}},
                    scheduler=args.scheduler,
                    workers=args.workers, out=args.out, resume=args.resume,
                    batched=args.batched, progress=None,

@@ -65,6 +65,11 @@ class ForceElement:
                     f"{self.frames[1]}{tuple(p['point_b'].tolist())}: "
                     + ", ".join(x for x in (law, damp) if x))
         if self.kind == "joint-spring-damper":
+            if p["law"] is not None:
+                law = p["law"].expression
+                return (f"on joint {p['joint']!r}: law "
+                        f"{law if law is not None else '(a function)'} of x = q - "
+                        f"{p['rest']:g}, v = q'")
             law = ("table" if p["force_table"] is not None else
                    f"k = {p['stiffness']:g}, rest {p['rest']:g}")
             return f"on joint {p['joint']!r}: {law}, c = {p['damping']:g}"

@@ -22,13 +22,15 @@ from .expressions import ExpressionError, parse, symbol, to_float
 from .initial import read_initial
 from .settings import read_outputs, read_simulation
 from .system_sections import add_bodies, add_forces, add_joints, add_loads
+from .urdf.section import add_section, read_section
 
 
 class SceneBuilder:
     """Builds System, Model and the Scene's fields from a merged, shape-checked document."""
 
-    def __init__(self, path, doc, checker, effects=None):
+    def __init__(self, path, doc, checker, effects=None, urdf_text=None):
         self.effects_override = effects
+        self.urdf_text = urdf_text   # a .urdf file's text, already read (a sweep's)
         self.path = path
         self.file = str(path)
         self.doc = doc
@@ -124,8 +126,10 @@ class SceneBuilder:
             warnings.simplefilter("always")
             self.parameters()
             model_table = doc.get("model", {})
-            name = model_table.get("name") or os.path.splitext(os.path.basename(self.file))[0]
-            system = self.add_system(name, model_table)
+            robot = read_section(self, model_table)
+            name = model_table.get("name") or (robot[1].name if robot else os.path.splitext(
+                os.path.basename(self.file))[0])
+            system = self.add_system(name, model_table, robot)
             effects = self.effects()
             with self.engine(()):
                 model = system.compile(effects=effects)
@@ -146,18 +150,21 @@ class SceneBuilder:
                     events=events, event_specs=event_specs,
                     warnings=tuple(m for m, _ in messages), document=doc,
                     joint_specs=self.joint_specs, load_specs=self.load_specs,
-                    body_specs=self.body_specs, force_specs=self.force_specs)
+                    body_specs=self.body_specs, force_specs=self.force_specs,
+                    urdf=self.urdf)
 
-    def add_system(self, name, model_table):
-        """The ``System`` of ``[model]``, its bodies, joints, loads and force elements; the
-        names a load may use (``PTQ``: parameters, ``t``, free coordinates and speeds)."""
+    def add_system(self, name, model_table, robot=None):
+        """The ``System`` of ``[model]``, the URDF ``robot`` it includes (``(path,
+        Robot)``), its bodies, joints, loads and force elements; the names a load may use
+        (``PTQ``: parameters, ``t``, free coordinates and speeds)."""
         gravity = self.pvector(model_table.get("gravity"), ("model", "gravity"),
                                default=(0.0, 0.0, -9.81))
         with self.engine(("model",)):
             system = System(name, gravity=gravity, parameters=self.values)
         self.system = system
-        self.body_specs = add_bodies(self)
-        self.joint_specs = add_joints(self)
+        self.urdf, bodies, joints = add_section(self, robot)
+        self.body_specs = bodies + add_bodies(self)
+        self.joint_specs = joints + add_joints(self)
         self.names_q = {}
         for j in system.joints.values():
             if j.drive is None:

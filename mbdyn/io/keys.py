@@ -6,7 +6,9 @@ from __future__ import annotations
 # value kinds: "string", "name", "expr", "vector", "axis", "inertia", "orientation",
 # "names", "bool", "condition", "direction", "reactions", ("choice", options)
 MODEL_KEYS = {"name": "string", "description": "string", "gravity": "vector",
-              "default_case": "string"}
+              "default_case": "string",
+              # a URDF robot the file includes (docs/urdf.md)
+              "urdf": "string", "floating": "bool", "accept_inertia": "bool"}
 BODY_KEYS = {"name": "name", "mass": "expr", "com": "vector", "inertia": "inertia",
              "inertia_about": ("choice", ("com", "origin")), "shape": "shape"}
 SHAPE_KEYS = {"type": ("choice", ("sphere", "box", "cylinder", "disk", "rod")),

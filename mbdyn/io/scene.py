@@ -22,6 +22,7 @@ from .checker import Checker
 from .document import parse_document, parse_set_value, read_document
 from .errors import ModelFileError
 from .settings import BUDGETS, SIMULATE_KEYWORDS
+from .urdf import is_urdf
 from .wording import suggest
 
 
@@ -53,8 +54,10 @@ def _normalise_overrides(overrides):
     return out
 
 
-def load_model(path, case=None, overrides=None, effects=None, *, text=None):
-    """Read a model file and return a ready-to-run ``Scene``.
+def load_model(path, case=None, overrides=None, effects=None, *, text=None, floating=None,
+               accept_inertia=None):
+    """Read a model file (TOML, or a URDF robot: ``.urdf``) and return a ready-to-run
+    ``Scene``.
 
     ``case``: the name of a ``[cases.NAME]`` table to apply (default: the file's
     ``model.default_case``, if any).  ``overrides``: ``{"parameters.Mz": -0.01, ...}``
@@ -63,11 +66,13 @@ def load_model(path, case=None, overrides=None, effects=None, *, text=None):
     the case.  ``effects``: switches applied after the file's ``[effects]``, as
     ``--effects`` takes them (``"-gravity,-damper"``, a list, or a mapping; see
     ``mbdyn.effects``).  ``text``: the file's content, already read (a sweep's member
-    carries its model's text, not a file); ``path`` then only names it.  Raises
-    ``ModelFileError`` (a ``ModelError``) naming file and key.
+    carries its model's text, not a file); ``path`` then only names it.  ``floating``,
+    ``accept_inertia``: a URDF robot's base hangs from the ground by a free joint ``root``;
+    inertias no body can have are accepted (``[model] floating``, ``accept_inertia``;
+    docs/urdf.md).  Raises ``ModelFileError`` (a ``ModelError``) naming file and key.
     """
     if not isinstance(path, (str, os.PathLike)):
-        raise ModelError(f"load_model: path must be the path of a .toml file, got {path!r}")
+        raise ModelError(f"load_model: path must be the path of a .toml or .urdf file, got {path!r}")
     if isinstance(overrides, str):
         raise ModelError("load_model: overrides must be a mapping {\"parameters.k\": 1.0} or "
                          "a list of \"PATH=VALUE\" texts, not one string")
@@ -75,7 +80,15 @@ def load_model(path, case=None, overrides=None, effects=None, *, text=None):
         raise ModelFileError(path, "", f"is more than a model file may be "
                              f"({limits.max_file_bytes()} characters; MBDYN_MAX_FILE_BYTES "
                              "raises it)")
-    doc = read_document(path) if text is None else parse_document(text, str(path))
+    urdf_text = None
+    if is_urdf(path):                 # a document of one key: the robot
+        doc, urdf_text = {"model": {"urdf": os.path.basename(str(path))}}, text
+    else:
+        doc = read_document(path) if text is None else parse_document(text, str(path))
+    overrides = _normalise_overrides(overrides) + [
+        (f"model.{key}", bool(value), f"{key}={bool(value)}")
+        for key, value in (("floating", floating), ("accept_inertia", accept_inertia))
+        if value is not None]
     checker = Checker(path)
     checker.check_document(doc)
     default_case = doc.get("model", {}).get("default_case")
@@ -89,13 +102,13 @@ def load_model(path, case=None, overrides=None, effects=None, *, text=None):
         merged = apply_case(doc, str(chosen), checker)
     else:
         merged = copy.deepcopy({k: v for k, v in doc.items() if k != "cases"})
-    for path_text, value, origin in _normalise_overrides(overrides):
+    for path_text, value, origin in overrides:
         apply_override(merged, path_text, value, checker, origin)
     checker.check_document(merged)
-    builder = SceneBuilder(path, merged, checker, effects)
+    builder = SceneBuilder(path, merged, checker, effects, urdf_text=urdf_text)
     scene = Scene(**builder.build())
     scene.case = chosen
-    scene.overrides = list(_normalise_overrides(overrides))
+    scene.overrides = list(overrides)
     scene.effects_spec = effects
     scene.cases = tuple(cases)
     scene.default_case = default_case
@@ -121,6 +134,7 @@ class Scene:
         self.case = None
         self.cases = ()
         self.default_case = None
+        self.urdf = None             # what a URDF robot held (docs/urdf.md), if any
         self.__dict__.update(fields)
 
     def __repr__(self):

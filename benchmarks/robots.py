@@ -1,0 +1,145 @@
+#!/usr/bin/env python
+"""URDF robots: mbdyn against Pinocchio per call -- forward dynamics (``aba``), inverse
+dynamics (``rnea``), mass matrix (``crba``) -- and the time to load a URDF file.
+
+    python benchmarks/robots.py            # the robots of tests/data/
+    python benchmarks/robots.py --quick    # a shorter time budget
+
+Pinocchio is for benchmarking only, never a dependency of mbdyn: install it into an
+environment that also sees mbdyn's (as benchmarks/peers.py says), or, with Pinocchio in a
+venv of its own (``python -m venv /tmp/pinvenv && /tmp/pinvenv/bin/pip install pin``,
+the same numpy as mbdyn's environment), add its site folder on the way in:
+
+    PYTHONPATH=. python -c "import site, runpy; \\
+        site.addsitedir('/tmp/pinvenv/lib/python3.11/site-packages'); \\
+        runpy.run_path('benchmarks/robots.py', run_name='__main__')"
+
+Both sides read the same file with their own parser; the dampers, friction and stops
+mbdyn makes of a URDF are switched off (Pinocchio's dynamics hold none), and the two are
+checked to agree at the state timed.  mbdyn's entries: the ordinary API
+(``Model.forward_dynamics(q, u)``, its default route; ``inverse_dynamics``, which returns
+dictionaries of efforts and reactions; ``mass_matrix``) and the low-level entry
+(``Model.lowlevel("auto").forward_dynamics``).  Per-call timing is
+``forward_dynamics.measure`` (blocks sized to a time budget, rounds interleaved); the
+ratio is mbdyn / Pinocchio.
+"""
+import os
+
+for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS"):
+    os.environ[_var] = "1"
+
+import sys  # noqa: E402
+import time  # noqa: E402
+import warnings  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import forward_dynamics as fdb  # noqa: E402  (this folder: the per-call timer)
+import numpy as np  # noqa: E402
+
+DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "data")
+ROBOTS = [("planar_arm", False), ("arm6", False), ("mixed", False), ("arm6", True)]
+
+
+def load_time(fn, rounds=20):
+    """Median wall time of ``fn()`` over ``rounds`` calls (after one to warm up)."""
+    fn()
+    times = []
+    for _ in range(rounds):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return float(np.median(times))
+
+
+def pin_state(pmodel, model, q, u):
+    """Pinocchio's ``(q, v)`` of mbdyn's ``(q, u)`` on a fixed base (joints by name;
+    a continuous joint's angle as ``(cos, sin)``)."""
+    import pinocchio as pin
+    qp, vp = pin.neutral(pmodel), np.zeros(pmodel.nv)
+    for jid in range(1, pmodel.njoints):
+        j, name = pmodel.joints[jid], pmodel.names[jid]
+        a = q[model.coordinates.index(name)]
+        if j.nq == 2:
+            qp[j.idx_q:j.idx_q + 2] = (np.cos(a), np.sin(a))
+        else:
+            qp[j.idx_q] = a
+        vp[j.idx_v] = u[model.speeds.index(f"{name}_dot")]
+    return qp, vp
+
+
+def robot_rows(name, floating, budget, repeats):
+    import pinocchio as pin
+
+    import mbdyn as mb
+    path = os.path.join(DATA, f"{name}.urdf")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        scene = mb.load_model(path, floating=floating)
+    model = scene.system.compile(effects=[f"-{n}" for n in scene.system.forces])
+    pmodel = (pin.buildModelFromUrdf(path, pin.JointModelFreeFlyer()) if floating
+              else pin.buildModelFromUrdf(path))
+    pdata = pmodel.createData()
+    rng = np.random.default_rng(1)
+    q = model.default_coordinates() + rng.uniform(-1, 1, model.nq)
+    model.normalize_quaternions(q)
+    u = rng.normal(size=model.nu)
+    ud = rng.normal(size=model.nu)
+    low = model.lowlevel("auto")
+    out = np.empty(model.nu)
+    cases = {
+        "fd": (model.forward_dynamics, (q, u), {}, 1),
+        "fd_low": (low.forward_dynamics, (q, u, 0.0, out), {}, 1),
+        "id": (model.inverse_dynamics, (q, u, ud), {}, 1),
+        "M": (model.mass_matrix, (q,), {}, 1),
+    }
+    ratios = [("fd", "aba"), ("fd_low", "aba"), ("id", "rnea"), ("M", "crba")]
+    if not floating:                         # the free flyer's speeds differ: not mapped
+        qp, vp = pin_state(pmodel, model, q, u)
+        tau = np.zeros(pmodel.nv)
+        ap = pin_state(pmodel, model, q, ud)[1]
+        ours = model.forward_dynamics(q, u)
+        theirs = pin.aba(pmodel, pdata, qp, vp, tau)
+        order = [model.speeds.index(f"{pmodel.names[j]}_dot") for j in range(1, pmodel.njoints)]
+        assert np.allclose(ours[order], theirs, rtol=1e-9, atol=1e-9), (ours, theirs)
+    else:
+        qp, vp = pin.randomConfiguration(pmodel, -np.ones(pmodel.nq), np.ones(pmodel.nq)), \
+            rng.normal(size=pmodel.nv)
+        tau, ap = np.zeros(pmodel.nv), rng.normal(size=pmodel.nv)
+    cases.update({
+        "aba": (pin.aba, (pmodel, pdata, qp, vp, tau), {}, 1),
+        "rnea": (pin.rnea, (pmodel, pdata, qp, vp, ap), {}, 1),
+        "crba": (pin.crba, (pmodel, pdata, qp), {}, 1),
+    })
+    stats, ratio = fdb.measure(cases, budget, repeats, ratios)
+
+    def loading():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            mb.load_model(path, floating=floating)
+    load = (load_time(loading), load_time(lambda: pin.buildModelFromUrdf(path)))
+    return model.nu, stats, ratio, load
+
+
+def main():
+    quick = "--quick" in sys.argv
+    budget, repeats = (1.0, 5) if quick else (4.0, 9)
+    import pinocchio as pin
+    print(f"Pinocchio {pin.__version__}; microseconds per call (median), ratio mbdyn / "
+          "Pinocchio\n")
+    print("| robot | nu | fd (ordinary) | fd (low-level) | aba | id | rnea | M | crba | "
+          "load mbdyn / Pinocchio (ms) |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for name, floating in ROBOTS:
+        nu, st, ratio, load = robot_rows(name, floating, budget, repeats)
+
+        def us(key, against=None):
+            text = f"{st[key]['median_us']:.2f}"
+            return text + (f" ({ratio[(key, against)]['median']:.2f}x)" if against else "")
+        print(f"| {name}{' floating' if floating else ''} | {nu} | {us('fd', 'aba')} | "
+              f"{us('fd_low', 'aba')} | {us('aba')} | {us('id', 'rnea')} | {us('rnea')} | "
+              f"{us('M', 'crba')} | {us('crba')} | {load[0] * 1e3:.1f} / "
+              f"{load[1] * 1e3:.2f} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
