@@ -221,6 +221,10 @@ class Model:
         preallocated buffers, for loops of your own; ``method``: ``"auto"``,
         ``"jourdain"`` or ``"articulated"``."""
         from .lowlevel import LowLevel
+        if self._con is not None:
+            raise ModelError(f"model {self.name!r} has closed loops: its low-level entry is "
+                             "not there yet (the tree's would ignore the loops); use "
+                             "model.forward_dynamics(q, u, t) or model.state_derivative(t, y)")
         return LowLevel(self, self.formulation(method))
 
     # ------------------------------------------------------------------ compiled loops

@@ -61,18 +61,17 @@ def constrained_solve(M, L, ud, G, gamma, lam, info):
             for k in range(i):
                 s -= L[i, k] * Y[k, j]
             Y[i, j] = s / L[i, i]
+    keep = info[2]               # during a run: the rank at the last projected state
+    if keep >= 0:
+        _pivoted_solve(L, ud, Y, res, lam, info, int(keep))
+        return
     U, sv, Vt = np.linalg.svd(Y, full_matrices=False)
     top = sv[0] if sv.shape[0] else 0.0
     rank = 0
     smallest = 1.0
     c = np.zeros(sv.shape[0])
-    keep = info[2]               # during a run: the rank at the last projected state
     for k in range(sv.shape[0]):
-        if keep >= 0:
-            use = k < keep and sv[k] > PASSAGE_TOLERANCE * top
-        else:
-            use = sv[k] > RANK_TOLERANCE * top
-        if use and top > 0.0:
+        if sv[k] > RANK_TOLERANCE * top and top > 0.0:
             rank += 1
             smallest = sv[k] / top
             acc = 0.0
@@ -84,7 +83,16 @@ def constrained_solve(M, L, ud, G, gamma, lam, info):
         for k in range(sv.shape[0]):
             acc += Vt[k, i] * c[k]
         lam[i] = acc
-    z = np.empty(nu)                                # M^-1 G^T lam = L^-T (Y lam)
+    _add_correction(L, ud, Y, lam)
+    info[0] = rank
+    info[1] = smallest
+
+
+@njit(cache=True, inline="always")
+def _add_correction(L, ud, Y, lam):
+    """``ud += M^-1 G^T lam = L^-T (Y lam)``."""
+    nu, m = Y.shape[0], Y.shape[1]
+    z = np.empty(nu)
     for i in range(nu):
         acc = 0.0
         for j in range(m):
@@ -97,8 +105,127 @@ def constrained_solve(M, L, ud, G, gamma, lam, info):
         z[i] = s / L[i, i]
     for i in range(nu):
         ud[i] += z[i]
+
+
+@njit(cache=True, inline="always")
+def _pivoted_cholesky(A, keep, perm):
+    """``A`` (symmetric, positive semi-definite) factored in place by Cholesky with
+    complete pivoting: at most ``keep`` pivots, none below ``PASSAGE_TOLERANCE^2`` of the
+    first (a nearly singular direction).  ``perm`` the chosen order; returns the number
+    of pivots, the rank used."""
+    m = A.shape[0]
+    for j in range(m):
+        perm[j] = j
+    rank = 0
+    first = 0.0
+    for k in range(min(keep, m)):
+        p = k
+        for j in range(k + 1, m):
+            if A[j, j] > A[p, p]:
+                p = j
+        if k == 0:
+            first = A[p, p]
+        if first <= 0.0 or not (A[p, p] > PASSAGE_TOLERANCE * PASSAGE_TOLERANCE * first):
+            break
+        if p != k:                                  # symmetric swap of rows and columns
+            for j in range(m):
+                A[k, j], A[p, j] = A[p, j], A[k, j]
+            for j in range(m):
+                A[j, k], A[j, p] = A[j, p], A[j, k]
+            perm[k], perm[p] = perm[p], perm[k]
+        A[k, k] = np.sqrt(A[k, k])
+        for i in range(k + 1, m):
+            A[i, k] /= A[k, k]
+        for j in range(k + 1, m):
+            for i in range(j, m):
+                A[i, j] -= A[i, k] * A[j, k]
+            for i in range(j + 1, m):
+                A[j, i] = A[i, j]
+        rank += 1
+    return rank
+
+
+@njit(cache=True, inline="always")
+def _pivoted_back(A, perm, rank, rhs, out):
+    """``out`` (all rows): the solution of the pivoted rows' system ``L_r L_r^T x =
+    rhs[perm[:rank]]`` at those rows, zero elsewhere."""
+    x = np.empty(rank)
+    for i in range(rank):
+        s = rhs[perm[i]]
+        for k in range(i):
+            s -= A[i, k] * x[k]
+        x[i] = s / A[i, i]
+    for i in range(rank - 1, -1, -1):
+        s = x[i]
+        for k in range(i + 1, rank):
+            s -= A[k, i] * x[k]
+        x[i] = s / A[i, i]
+    for j in range(out.shape[0]):
+        out[j] = 0.0
+    for i in range(rank):
+        out[perm[i]] = x[i]
+
+
+@njit(cache=True)
+def _pivoted_solve(L, ud, Y, res, lam, info, keep):
+    """The constrained ``ud`` during a run, whose rank ``keep`` is known: ``S = Y^T Y``
+    factored by Cholesky with complete pivoting (``_pivoted_cholesky``), and the
+    multipliers of the rows it chose solved for, the others zero.  The rows left out are
+    combinations of the rows kept, so ``u'`` is the same as by the SVD (it is unique);
+    ``lam`` is a basic solution, not the minimum-norm one (reactions are computed by
+    ``constrained_solve`` outside runs).  An SVD costs more than a small tree's whole
+    evaluation; this, a fraction of it."""
+    m = Y.shape[1]
+    A = np.empty((m, m))
+    for i in range(m):
+        for j in range(i + 1):
+            acc = 0.0
+            for k in range(Y.shape[0]):
+                acc += Y[k, i] * Y[k, j]
+            A[i, j] = acc
+            A[j, i] = acc
+    perm = np.empty(m, np.int64)
+    first = 0.0
+    for i in range(m):
+        first = max(first, A[i, i])
+    rank = _pivoted_cholesky(A, keep, perm)
+    _pivoted_back(A, perm, rank, res, lam)
+    _add_correction(L, ud, Y, lam)
     info[0] = rank
-    info[1] = smallest
+    info[1] = A[rank - 1, rank - 1] / np.sqrt(first) if rank and first > 0 else 1.0
+
+
+@njit(cache=True)
+def min_norm_step(G, rhs, keep, du):
+    """``du``: the minimum-norm solution of ``G du = rhs`` -- by ``G^T (G G^T)^+ rhs`` on
+    the rows a pivoted Cholesky of ``G G^T`` keeps (``keep`` at most) during a run, by
+    least squares (SVD) when the rank is not known (``keep < 0``).  Returns the last
+    pivot's singular value over the first's (an estimate of ``G``'s conditioning; 1.0
+    by least squares)."""
+    m, nu = G.shape[0], G.shape[1]
+    if keep < 0:
+        x = np.linalg.lstsq(G, rhs, RANK_TOLERANCE)[0]
+        for k in range(nu):
+            du[k] = x[k]
+        return 1.0
+    A = np.empty((m, m))
+    for i in range(m):
+        for j in range(i + 1):
+            acc = 0.0
+            for k in range(nu):
+                acc += G[i, k] * G[j, k]
+            A[i, j] = acc
+            A[j, i] = acc
+    perm = np.empty(m, np.int64)
+    z = np.empty(m)
+    rank = _pivoted_cholesky(A, keep, perm)
+    _pivoted_back(A, perm, rank, rhs, z)
+    for k in range(nu):
+        acc = 0.0
+        for i in range(m):
+            acc += G[i, k] * z[i]
+        du[k] = acc
+    return A[rank - 1, rank - 1] / A[0, 0] if rank else 1.0
 
 
 @njit(cache=True)
@@ -188,6 +315,7 @@ def project_state(y, nq, slots, quats, free_q, free_u, tree, state, motion, con,
     con_int, con_data, phi, psi, G, gamma, lam, info = con
     nu = y.shape[0] - nq
     dq = np.empty(nq)
+    du = np.empty(nu)
     steps = 0
     while True:
         for k in range(nq):
@@ -202,7 +330,7 @@ def project_state(y, nq, slots, quats, free_q, free_u, tree, state, motion, con,
             break
         if steps == PROJECTION_ITERATIONS:
             return -1
-        du = np.linalg.lstsq(G, phi, RANK_TOLERANCE)[0]
+        min_norm_step(G, phi, int(info[2]), du)
         coordinate_rates(y[:nq], du, slots, dq)
         for k in range(nq):
             y[k] -= dq[k]
@@ -212,14 +340,14 @@ def project_state(y, nq, slots, quats, free_q, free_u, tree, state, motion, con,
             for k in range(4):
                 y[i + k] /= nrm
         steps += 1
-    if residual_norm(psi) > 0.0:
-        du = np.linalg.lstsq(G, psi, RANK_TOLERANCE)[0]
-        for k in range(nu):
-            y[nq + k] -= du[k]
+    ratio = min_norm_step(G, psi, int(info[2]), du)
+    for k in range(nu):
+        y[nq + k] -= du[k]
     if info[2] >= 0:                 # a run: the rank here, for the next step's stages
-        rank, ratio = rank_of(G)
-        info[2] = rank
-        info[3] = min(info[3], rank)
+        if ratio < 1e-3:             # near a singular configuration: decide it exactly
+            rank, ratio = rank_of(G)
+            info[2] = rank
+            info[3] = min(info[3], rank)
         info[4] = min(info[4], ratio)
     return steps
 

@@ -28,6 +28,7 @@ import numpy as np
 from numba import njit
 
 from .joints import REVOLUTE
+from .views import c_view
 
 POINT, PERP, SLIDE, DIST, COUPLE = 0, 1, 2, 3, 4
 #: rows each primitive contributes
@@ -126,17 +127,38 @@ def constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
     """Fill the residuals ``phi`` (positions), ``psi`` (their rates), the Jacobian ``G``
     (rows x free speeds) and ``gamma``, after a kinematic walk at the state (bias
     accelerations in ``alpha``, ``a``: free speed rates zero, drives' rates given)."""
+    _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull, R, r, w, v,
+                     alpha, a, JR, JT, phi, psi, G, gamma,
+                     np.empty(ROW_WORK + G.shape[0] * G.shape[1]))
+
+
+#: floats of scratch ``_constraint_rows`` takes besides ``G``'s size
+ROW_WORK = 57
+
+
+@njit(cache=True)
+def _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
+                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, work):
+    """``constraint_rows`` in the scratch ``work`` (one allocation by the caller: the
+    vectors below are views of it, which cost no allocation each)."""
     # long: one loop over the primitives, each kind's rows written where they are derived
     # (a reader checks a kind's residual, rate, Jacobian and gamma side by side).
-    w0 = np.zeros(3)
-    rp, Pp, vp, ap = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
-    rc, Pc, vc, ac = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
-    va, vb, axb, t1, t2, t3, d, dv = (np.empty(3), np.empty(3), np.empty(3), np.empty(3),
-                                      np.empty(3), np.empty(3), np.empty(3), np.empty(3))
-    Gabs = np.zeros(G.shape)
+    w0, rp, Pp, vp = (c_view(work, 0, (3,)), c_view(work, 3, (3,)), c_view(work, 6, (3,)),
+                      c_view(work, 9, (3,)))
+    ap, rc, Pc, vc = (c_view(work, 12, (3,)), c_view(work, 15, (3,)), c_view(work, 18, (3,)),
+                      c_view(work, 21, (3,)))
+    ac, va, vb, axb = (c_view(work, 24, (3,)), c_view(work, 27, (3,)),
+                       c_view(work, 30, (3,)), c_view(work, 33, (3,)))
+    t1, t2, t3, d = (c_view(work, 36, (3,)), c_view(work, 39, (3,)), c_view(work, 42, (3,)),
+                     c_view(work, 45, (3,)))
+    dv = c_view(work, 48, (3,))
+    Gabs = c_view(work, ROW_WORK, (G.shape[0], G.shape[1]))
+    for k in range(3):
+        w0[k] = 0.0
     for k in range(G.shape[0]):
         for col in range(G.shape[1]):
             G[k, col] = 0.0
+            Gabs[k, col] = 0.0
     row = 0
     for m in range(con_int.shape[0]):
         kind, ip, ic = con_int[m, 0], con_int[m, 1], con_int[m, 2]
