@@ -4,7 +4,8 @@ Each command is a submodule ``mbdyn.cli.NAME`` listed in ``COMMANDS`` with a
 ``register(subparsers)`` function that adds its parser and sets ``func`` (called with the
 parsed arguments, returns the exit code); ``common.add_command`` makes that parser.  To add a command, write the module and append
 its name to ``COMMANDS`` and its one-line help to ``SUMMARIES``.  Only the module of the
-command that runs is imported.
+command that runs is imported.  A command that will compile numeric kernels says so on
+stderr first, within a second of its start (``compiling``).
 
 Exit codes: 0 success; 1 a model file or input that cannot be used (one-line message on
 stderr); 2 a bad command line; 3 a simulation that failed (NaN, singularity, integrator
@@ -23,7 +24,7 @@ import sys
 import warnings
 
 COMMANDS = ["run", "info", "eom", "accuracy", "equilibrium", "modes", "campbell", "plot",
-            "animate", "sweep"]
+            "animate", "sweep", "warmup"]
 #: each command's one-line help, for ``mbdyn --help``: the parser lists every command from
 #: here and imports only the module of the command that runs (importing all of them would
 #: load sympy's printers, scipy and the analysis layer for any command)
@@ -39,6 +40,7 @@ SUMMARIES = {
     "animate": "animate a run: GIF, MP4 or a self-contained HTML view",
     "sweep": "run a model file over a grid of overrides (parameters, initial state, "
              "settings); one table row per member",
+    "warmup": "compile the numeric kernels ahead of time (once per machine)",
 }
 
 EXIT_OK, EXIT_INPUT, EXIT_USAGE, EXIT_SIMULATION, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
@@ -116,6 +118,8 @@ def main(argv=None):
     # value the user set is kept.
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     argv = sys.argv[1:] if argv is None else list(argv)
+    from . import compiling
+    compiling.announce_if_cold(_command(argv), argv)    # before the parser's imports
     parser = build_parser(_command(argv))
     try:
         args = parser.parse_args(argv)
@@ -132,7 +136,9 @@ def main(argv=None):
     except ValueError:                # not the main thread (e.g. called from a test)
         previous = None
     try:
-        code = _dispatch(args, debug, ModelError, SimulationError)
+        with _watch(args.command) as watch:
+            code = _dispatch(args, debug, ModelError, SimulationError)
+        watch.close()
         sys.stdout.flush()              # a closed pipe shows here, not at exit
         return code
     except BrokenPipeError:
@@ -141,6 +147,26 @@ def main(argv=None):
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
+
+
+def _watch(command):
+    """numba's compile events watched for the notice and the progress of a command that
+    compiles (``compiling.Watch``), or a stand-in that watches nothing."""
+    from . import compiling
+    if command in compiling.COMPILING and compiling.enabled():
+        return compiling.Watch()
+    return _Unwatched()
+
+
+class _Unwatched:
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        return None
+
+    def close(self):
+        return None
 
 
 def _dispatch(args, debug, ModelError, SimulationError):

@@ -1,0 +1,303 @@
+"""Saying so when a command compiles the numeric kernels (issue 27, item 1).
+
+A command's first use of a kernel on a machine compiles it with numba (seconds to a
+minute); later uses load it from numba's on-disk cache.  A command says so once, on
+stderr, before the silent wait::
+
+    mbdyn: compiling the numeric kernels for this machine, once: ~20 s (later runs load them
+    from the cache; `mbdyn warmup` compiles them all ahead of time)
+
+and, on a terminal, shows which kernel it is compiling and for how long, then how long it
+took in all.  Two parts, because the notice must come within a second of the command's
+start and the first compile begins only after the imports and the model's reading (about
+1.5 s on a busy 2-core machine):
+
+* ``announce_if_cold(command, argv)``, before anything heavy is imported: looks for the
+  cache index files (``*.nbi``) of the kernels the command always calls (``CORE``) where
+  numba keeps them (``cache_dir``), without importing numba, and checks that each index
+  is of the installed numba and of the current source (its SHA-256, which numba stores in
+  the index); for a command that simulates, also those of the integrator it will use
+  (``--integrator``, or the model file's, read with ``tomllib``).  One missing: the
+  notice, with an estimate from ``SECONDS``.
+* ``Watch``, a listener on numba's ``numba:compile`` events for the rest of the command:
+  exact (numba sends the event only when it compiles, never on a cache hit), so a kernel
+  outside ``CORE`` (another integrator's loop, force elements, a closed loop) or a new
+  argument type still gets the notice, when its compile begins.
+
+``MBDYN_COMPILE_NOTICE=0`` turns both off (the test suite does, except in the tests of the
+notice itself).
+"""
+from __future__ import annotations
+
+import hashlib
+import os
+import sys
+import threading
+import time
+from pathlib import Path
+
+PACKAGE = Path(__file__).resolve().parent.parent
+
+#: the entry points (compiled from Python) every command that reads a model calls, as
+#: ``(kernels module, qualname)``: the check of the model's inertia and the mass matrix's
+#: condition (measured with numba's compile events)
+CORE = (("evaluate", "kinematics_and_loads"), ("dynamics", "jourdain_terms"),
+        ("dynamics", "cholesky_solve"))
+#: the commands that call ``CORE``, and those of them that simulate (their integrator's
+#: kernels are checked too, ``INTEGRATOR_KERNELS``)
+COMPILING = ("run", "info", "accuracy", "equilibrium", "modes", "campbell", "plot",
+             "animate", "sweep")
+SIMULATING = ("run", "accuracy", "plot", "animate", "sweep")
+_ADAPTIVE = (("adaptive", "rk_stretch"), ("packed", "state_derivative_packed"))
+#: the entry points an integrator adds (a model's first run with it)
+INTEGRATOR_KERNELS = {
+    "DOP853": _ADAPTIVE, "RK45": _ADAPTIVE,
+    "semi-implicit-euler": (("integrators", "semi_implicit_euler_loop"),),
+    "euler": (("integrators", "euler_loop"),), "rk4": (("integrators", "rk4_loop"),),
+    "implicit-midpoint": (("integrators", "implicit_midpoint_loop"),),
+}
+#: cold compile of each entry point with everything below it, CPU seconds on a 2-core
+#: machine (numba 0.68; ``mbdyn warmup``'s first routes, docs/performance.md): the
+#: estimate's source.  Others count ``OTHER`` seconds.
+SECONDS = {"kinematics_and_loads": 3.1, "jourdain_terms": 1.8, "cholesky_solve": 0.9,
+           "rk_stretch": 13.4, "state_derivative_packed": 6.9,
+           "semi_implicit_euler_loop": 3.4, "euler_loop": 3.3, "rk4_loop": 7.9,
+           "implicit_midpoint_loop": 10.0}
+OTHER = 5.0
+#: what a simulation compiles besides its integrator (the reactions' Newton-Euler system,
+#: the energies, the drives' programs)
+RUN_EXTRA = 2.0
+
+_STATE = {"announced": False, "estimate": None}
+_LOCK = threading.Lock()
+
+
+def enabled():
+    return os.environ.get("MBDYN_COMPILE_NOTICE", "1").strip() not in ("0", "no", "off",
+                                                                        "false")
+
+
+def cache_dir(source):
+    """Where numba keeps the cache of the functions of the file ``source``, by numba's
+    own rules (``numba.core.caching``): ``NUMBA_CACHE_DIR/<dir>_<sha1 of the dir>`` when
+    that variable is set, else ``__pycache__`` beside the file when it can be written,
+    else the user's cache folder.  ``None`` when numba's locators are replaced
+    (``NUMBA_CACHE_LOCATOR_CLASSES``) or caching is off (``NUMBA_DISABLE_JIT``)."""
+    if os.environ.get("NUMBA_CACHE_LOCATOR_CLASSES") or os.environ.get("NUMBA_DISABLE_JIT",
+                                                                       "0") != "0":
+        return None
+    folder = os.path.dirname(os.path.abspath(source))
+    sub = os.path.basename(folder) + "_" + hashlib.sha1(folder.encode()).hexdigest()
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return os.path.join(os.environ["NUMBA_CACHE_DIR"], sub)
+    in_tree = os.path.join(folder, "__pycache__")
+    if os.access(in_tree if os.path.isdir(in_tree) else folder, os.W_OK):
+        return in_tree
+    if sys.platform == "darwin":
+        base = os.path.expanduser("~/Library/Caches")
+    else:
+        base = os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache")
+    return os.path.join(base, "numba", sub)
+
+
+def _numba_version():
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        return version("numba")
+    except PackageNotFoundError:
+        return None
+
+
+def is_cached(module, qualname, numba_version=None):
+    """Whether numba's cache holds ``mbdyn.kernels.<module>.<qualname>`` compiled from
+    the current source by the installed numba (for some argument types)."""
+    import pickle
+    source = PACKAGE / "kernels" / f"{module}.py"
+    folder = cache_dir(source)
+    if folder is None or not os.path.isdir(folder):
+        return False
+    digest = hashlib.sha256(source.read_bytes()).digest()
+    numba_version = numba_version or _numba_version()
+    tag = f"py{sys.version_info.major}{sys.version_info.minor}"
+    for name in os.listdir(folder):
+        if not (name.startswith(f"{module}.{qualname}-") and name.endswith(".nbi")
+                and tag in name):
+            continue
+        try:
+            with open(os.path.join(folder, name), "rb") as f:
+                if pickle.load(f) == numba_version and digest in f.read():
+                    return True
+        except (OSError, pickle.UnpicklingError, EOFError, ValueError):
+            continue
+    return False
+
+
+def missing(entries=CORE):
+    """The entry points of ``entries`` (``(module, qualname)`` pairs) not in the cache."""
+    version = _numba_version()
+    return [q for m, q in entries if not is_cached(m, q, version)]
+
+
+def announce(seconds, stream=None):
+    """The notice, once per process; returns whether it was written now."""
+    with _LOCK:
+        if _STATE["announced"]:
+            return False
+        _STATE["announced"] = True
+        _STATE["estimate"] = max(1, round(seconds))
+    stream = stream or sys.stderr
+    stream.write(f"mbdyn: compiling the numeric kernels for this machine, once: "
+                 f"~{max(1, round(seconds))} s (later runs load them from the cache; "
+                 "`mbdyn warmup` compiles them all ahead of time)\n")
+    stream.flush()
+    return True
+
+
+def _option(words, flag):
+    for k, w in enumerate(words):
+        if w == flag and k + 1 < len(words):
+            return words[k + 1]
+        if w.startswith(flag + "="):
+            return w.split("=", 1)[1]
+    return None
+
+
+def integrator_of(model, words):
+    """The integrator a command line runs ``model`` with, read without the model's
+    loader: ``--integrator``, else the case's or the file's ``[simulation] integrator``,
+    else the default DOP853; ``None`` if the file cannot be read as TOML here."""
+    chosen = _option(words, "--integrator")
+    if chosen:
+        return chosen
+    import tomllib
+    try:
+        if os.path.getsize(model) > 1_000_000:
+            return None
+        with open(model, "rb") as f:
+            data = tomllib.load(f)
+        case = _option(words, "--case") or data.get("model", {}).get("default_case")
+        for table in (data.get("cases", {}).get(case, {}) if case else {}, data):
+            value = table.get("simulation", {}).get("integrator")
+            if isinstance(value, str):
+                return value
+    except (OSError, ValueError, AttributeError):
+        return None
+    return "DOP853"
+
+
+def announce_if_cold(command, argv):
+    """Before a command that compiles (``COMPILING``) is even parsed (the parser imports
+    its layers, a second): the notice if one of the ``CORE`` kernels, or of the kernels of
+    the integrator a simulating command will use, is not cached.  Nothing for help, nor
+    when the word after the command (the model file) is not a file (a mistyped path fails
+    at once; a model named after options is left to ``Watch``)."""
+    if command not in COMPILING or not enabled() or _STATE["announced"]:
+        return False
+    words = list(argv)
+    rest = words[words.index(command) + 1:]
+    if any(w in ("-h", "--help", "--version") for w in words) or not rest or not \
+            os.path.isfile(rest[0]):
+        return False
+    entries = CORE
+    if command in SIMULATING:
+        entries += INTEGRATOR_KERNELS.get(integrator_of(rest[0], rest), ())
+    cold = missing(entries)
+    if not cold:
+        return False
+    extra = RUN_EXTRA if command in SIMULATING else 0.0
+    return announce(sum(SECONDS.get(q, OTHER) for q in cold) + extra)
+
+
+class Watch:
+    """A listener on numba's compile events for one command: the notice when a compile
+    begins (if not given yet), on a terminal a line that shows the kernel and the time
+    spent, rewritten in place; ``close()`` says what it compiled and how long it took.
+    ``compiled``: ``[(entry point, seconds)]`` of the kernels compiled from Python."""
+
+    def __init__(self, stream=None, notice=True, live=None):
+        self.stream = stream or sys.stderr
+        self.notice = notice
+        isatty = getattr(self.stream, "isatty", lambda: False)
+        self.live = isatty() if live is None else live
+        self.depth, self.current, self.began = 0, None, None
+        self.compiled = []
+        self._ticker = None
+        self._shown = False
+        self._listener = None
+
+    def __enter__(self):
+        from numba.core import event
+
+        watch = self
+
+        class Listener(event.Listener):
+            def on_start(self, ev):
+                watch._start(ev.data["dispatcher"].py_func.__qualname__)
+
+            def on_end(self, ev):
+                watch._end()
+        self._listener = Listener()
+        event.register("numba:compile", self._listener)
+        return self
+
+    def __exit__(self, *exc):
+        from numba.core import event
+        event.unregister("numba:compile", self._listener)
+        self._clear()
+
+    def _start(self, name):
+        self.depth += 1
+        if self.depth > 1:
+            return
+        if self.notice and enabled():
+            announce(SECONDS.get(name, OTHER) + RUN_EXTRA, self.stream)
+        with _LOCK:
+            self.current, self.began = name, time.perf_counter()
+        if self.live and self.notice and enabled() and self._ticker is None:
+            self._ticker = threading.Thread(target=self._tick, daemon=True)
+            self._ticker.start()
+
+    def _end(self):
+        self.depth -= 1
+        if self.depth:
+            return
+        with _LOCK:
+            self.compiled.append((self.current, time.perf_counter() - self.began))
+            self.current = None
+            self._clear_locked()
+
+    def _tick(self):
+        while True:
+            time.sleep(0.25)
+            with _LOCK:
+                if self._ticker is None:
+                    return
+                if self.current is None:
+                    continue
+                spent = sum(s for _, s in self.compiled) + time.perf_counter() - self.began
+                of = f" of ~{_STATE['estimate']} s" if (_STATE["estimate"] or 0) > spent \
+                    else ""
+                self.stream.write(f"\rmbdyn: compiling {self.current}: {spent:.0f} s so "
+                                  f"far{of} ({len(self.compiled)} kernels done)\x1b[K")
+                self.stream.flush()
+                self._shown = True
+
+    def _clear_locked(self):
+        if self._shown:
+            self.stream.write("\r\x1b[K")
+            self.stream.flush()
+            self._shown = False
+
+    def _clear(self):
+        with _LOCK:
+            self._ticker = None
+            self._clear_locked()
+
+    def close(self):
+        """The closing line after a command that compiled (nothing otherwise)."""
+        if not self.compiled or not (self.notice and enabled()):
+            return
+        total = sum(s for _, s in self.compiled)
+        self.stream.write(f"mbdyn: compiled {len(self.compiled)} kernels in {total:.0f} s; "
+                          "they are cached for the next runs\n")
+        self.stream.flush()

@@ -1,0 +1,167 @@
+"""A command that compiles says so, at once (issue 27, item 1): the notice on a fresh
+numba cache within a second of the start, none when the kernels are cached, the cache
+found where numba keeps it, progress on a terminal, and ``mbdyn warmup``."""
+from __future__ import annotations
+
+import io
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from mbdyn.cli import compiling, main
+
+ROOT = Path(__file__).resolve().parent.parent
+NOTICE = "mbdyn: compiling the numeric kernels for this machine, once: ~"
+
+
+def _env(**extra):
+    return dict(os.environ, PYTHONPATH=str(ROOT), MBDYN_COMPILE_NOTICE="1", **extra)
+
+
+def test_the_readme_command_on_a_fresh_cache_says_so_within_a_second(tmp_path):
+    """The README's first command with an empty numba cache: the first line on stderr is
+    the notice, and it comes within 1 s of the start (the compile itself begins after
+    about 1.5 s of imports and reading; the process is stopped once the line is read)."""
+    start = time.perf_counter()
+    proc = subprocess.Popen([sys.executable, "-m", "mbdyn", "run", "models/top.toml",
+                             "--case", "a"], cwd=ROOT, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, text=True,
+                            env=_env(NUMBA_CACHE_DIR=str(tmp_path)))
+    try:
+        first = proc.stderr.readline()
+        elapsed = time.perf_counter() - start
+    finally:
+        proc.kill()
+        proc.wait()
+    assert first.startswith(NOTICE) and "mbdyn warmup" in first, first
+    assert int(first[len(NOTICE):].split()[0]) >= 10       # "~N s": the estimate
+    assert elapsed < 1.0, elapsed
+
+
+def test_no_notice_when_the_kernels_are_cached(tmp_path):
+    """Once compiled (the first run here, if the cache is cold), the same command says
+    nothing about compiling; ``--json`` keeps stdout one JSON object either way."""
+    argv = [sys.executable, "-m", "mbdyn", "run", "models/top.toml", "--case", "a",
+            "--t-end", "0.05", "--json"]
+    for attempt in range(2):
+        done = subprocess.run(argv, cwd=ROOT, capture_output=True, text=True, env=_env())
+        assert done.returncode == 0, done.stderr
+        assert json.loads(done.stdout)["model"] == "heavy top"
+    assert "compil" not in done.stderr, done.stderr
+
+
+def test_the_check_finds_the_cache_where_numba_keeps_it(tmp_path):
+    """``compiling.cache_dir`` names the folder numba's own locator chose, in the tree
+    and under ``NUMBA_CACHE_DIR``; an index of other source is not taken for a hit."""
+    probe = ("import json; from mbdyn.cli import compiling; import mbdyn.kernels.evaluate"
+             " as e, mbdyn.kernels.dynamics as d\n"
+             "fs = [e.kinematics_and_loads, d.jourdain_terms, d.cholesky_solve]\n"
+             "print(json.dumps([[f._cache._cache_path, compiling.cache_dir("
+             "f.py_func.__code__.co_filename)] for f in fs]))")
+    for extra in ({}, {"NUMBA_CACHE_DIR": str(tmp_path)}):
+        done = subprocess.run([sys.executable, "-c", probe], cwd=ROOT, capture_output=True,
+                              text=True, env=_env(**extra), check=True)
+        for numba_says, ours in json.loads(done.stdout):
+            assert numba_says == ours
+
+
+def test_an_index_of_other_source_or_another_numba_is_not_a_hit(tmp_path, monkeypatch):
+    """numba stores the source's SHA-256 and its own version in the index: an index
+    written for another source or by another numba does not count."""
+    import hashlib
+    import pickle
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    source = compiling.PACKAGE / "kernels" / "evaluate.py"
+    folder = Path(compiling.cache_dir(source))
+    folder.mkdir(parents=True)
+    tag = f"py{sys.version_info.major}{sys.version_info.minor}"
+    index = folder / f"evaluate.kinematics_and_loads-30.{tag}.nbi"
+    digest = hashlib.sha256(source.read_bytes()).digest()
+    for version, stamp, hit in ((compiling._numba_version(), digest, True),
+                                (compiling._numba_version(), b"x" * 32, False),
+                                ("0.1.0", digest, False)):
+        index.write_bytes(pickle.dumps(version) + b"(stamp " + stamp + b" overloads)")
+        assert compiling.is_cached("evaluate", "kinematics_and_loads") is hit
+    assert compiling.is_cached("evaluate", "energies") is False
+
+
+def test_a_cached_core_is_seen_as_cached(monkeypatch):
+    """After the core kernels ran in this process, the check finds every one of them,
+    and the notice is not given."""
+    import numpy as np
+
+    import mbdyn as mb
+    s = mb.System("p", gravity=(0, 0, -9.81))
+    s.add_body("b", mass=1.0, com=(0, 0, -1), inertia=(1e-3, 1e-3, 1e-3))
+    s.add_joint("q", "revolute", "ground", "b", axis="y")
+    model = s.compile()
+    model.forward_dynamics(np.array([0.1]), np.array([0.0]))
+    model.mass_matrix_condition(np.array([0.1]))
+    assert compiling.missing() == []
+    monkeypatch.setenv("MBDYN_COMPILE_NOTICE", "1")
+    monkeypatch.setitem(compiling._STATE, "announced", False)
+    top = str(ROOT / "models" / "top.toml")
+    assert compiling.announce_if_cold("run", ["run", top]) is False
+    monkeypatch.setenv("NUMBA_CACHE_DIR", "/nonexistent/empty")
+    assert set(compiling.missing()) == {"kinematics_and_loads", "jourdain_terms",
+                                        "cholesky_solve"}
+    assert compiling.announce_if_cold("run", ["run", "missing.toml"]) is False
+    assert compiling.announce_if_cold("eom", ["eom", top]) is False
+    assert compiling.announce_if_cold("run", ["run", top, "--help"]) is False
+
+
+def test_the_notice_is_given_once_and_progress_shows_on_a_terminal(monkeypatch):
+    """One notice, with the first kernel's estimate; on a terminal the kernel, the time
+    so far and the estimate, rewritten in place and cleared; a closing line."""
+    monkeypatch.setenv("MBDYN_COMPILE_NOTICE", "1")
+    monkeypatch.setitem(compiling._STATE, "announced", False)
+    monkeypatch.setitem(compiling._STATE, "estimate", None)
+
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+    stream = Terminal()
+    watch = compiling.Watch(stream=stream)
+    watch._start("jourdain_terms")
+    time.sleep(0.7)
+    watch._end()
+    watch._start("energies")
+    watch._end()
+    watch._clear()
+    watch.close()
+    text = stream.getvalue()
+    assert text.count(NOTICE) == 1
+    assert "\rmbdyn: compiling jourdain_terms: 0 s so far of ~4 s (0 kernels done)" in text
+    assert "\r\x1b[K" in text
+    assert text.endswith("mbdyn: compiled 2 kernels in 1 s; they are cached for the next "
+                         "runs\n")
+    assert compiling.announce(5.0, stream) is False          # once per process
+    quiet = io.StringIO()                                    # not a terminal: no progress
+    watch = compiling.Watch(stream=quiet)
+    watch._start("x")
+    time.sleep(0.4)
+    watch._end()
+    assert "\r" not in quiet.getvalue()
+    monkeypatch.setenv("MBDYN_COMPILE_NOTICE", "0")
+    silent = io.StringIO()
+    watch = compiling.Watch(stream=silent)
+    watch._start("x")
+    watch._end()
+    watch.close()
+    assert silent.getvalue() == ""
+
+
+def test_warmup_compiles_the_main_routes_and_says_what_each_took(capsys):
+    """``mbdyn warmup``: every main route runs (compiling what the cache lacks) and is
+    reported with its time; a second call finds them all cached."""
+    assert main(["warmup"]) == 0
+    assert main(["warmup"]) == 0
+    out = capsys.readouterr().out.split("mbdyn warmup:")[-1]
+    for route in ("jourdain", "fixed-step", "articulated", "force elements", "closed loop",
+                  "total"):
+        assert f"\n  {route} " in out, out
+    assert "failed" not in out and "batched" not in out
+    assert out.count(" cached ") == 5, out
