@@ -35,7 +35,7 @@ def stretch_events(events, model, g_old, t_start, y_start, T, Y, H, out_K, tab, 
     crossing located by brentq on the step's dense polynomial.  ``G``: the conditions at the
     rows when the stretch computed them (it then ended at its first crossing, and ``out_K``
     holds that last step's stages in its last row)."""
-    from ..kernels.adaptive import dense_step, dense_values
+    from ..kernels.adaptive import dense_step
     nq = model.nq
     ends, found = [], {}
     if G is None:
@@ -149,7 +149,6 @@ class _Stretches:
     def _first_step(self):
         """``f(t0, y0)`` and scipy's initial step size; a failure there is a
         ``SimulationError`` whose result holds the initial state."""
-        from ..kernels.adaptive import initial_step
         plan, model = self.plan, self.model
         t0, y0, nq = plan.t0, plan.y0, model.nq
         try:
@@ -332,3 +331,32 @@ class _Stretches:
         if not len(ts):
             ts, ys = np.array([self.t]), self.y[None, :].copy()
         return Outcome(ts, ys, self.found, info)
+
+
+# Python helpers of the compiled stretches (run once per run or per sample batch)
+def initial_step(fun, y0, f0, span, max_step, order, rtol, atol):
+    """A first step size from the size of ``y0``, ``f0`` and a difference estimate of the
+    second derivative (Hairer, Norsett & Wanner, II.4); ``fun(h, y)`` is the derivative at
+    ``t0 + h``; at most ``span`` and ``max_step``."""
+    scale = atol + np.abs(y0) * rtol
+    rms = lambda x: np.sqrt(np.mean(x * x))
+    d0, d1 = rms(y0 / scale), rms(f0 / scale)
+    h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
+    h0 = min(h0, span)
+    f1 = fun(h0, y0 + h0 * f0)
+    d2 = rms((f1 - f0) / scale) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / (order + 1))
+    return min(100 * h0, h1, span, max_step)
+
+
+def dense_values(F, y_old, x):
+    """The dense polynomial at the fractions ``x`` (array) of the step: ``(len(x), n)``."""
+    x = np.atleast_1d(np.asarray(x, dtype=float))[:, None]
+    acc = np.zeros((x.shape[0], F.shape[1]))
+    for r in range(F.shape[0] - 1, -1, -1):
+        acc += F[r]
+        acc *= x if r % 2 == 0 else 1.0 - x
+    return y_old + acc

@@ -178,24 +178,6 @@ TABLEAUS = {
 }
 
 
-def initial_step(fun, y0, f0, span, max_step, order, rtol, atol):
-    """A first step size from the size of ``y0``, ``f0`` and a difference estimate of the
-    second derivative (Hairer, Norsett & Wanner, II.4); ``fun(h, y)`` is the derivative at
-    ``t0 + h``; at most ``span`` and ``max_step``."""
-    scale = atol + np.abs(y0) * rtol
-    rms = lambda x: np.sqrt(np.mean(x * x))
-    d0, d1 = rms(y0 / scale), rms(f0 / scale)
-    h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
-    h0 = min(h0, span)
-    f1 = fun(h0, y0 + h0 * f0)
-    d2 = rms((f1 - f0) / scale) / h0
-    if d1 <= 1e-15 and d2 <= 1e-15:
-        h1 = max(1e-6, h0 * 1e-3)
-    else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / (order + 1))
-    return min(100 * h0, h1, span, max_step)
-
-
 @njit(cache=True, inline="always")
 def _stage(t, y, ops, consts, starts, stack, dv, nq, slots, free_q, free_u, drive_q, drive_u,
            tree, body, loads, ws, ydot, nfev):
@@ -440,13 +422,3 @@ def dense_step(A, C, D, stages, t_old, y_old, y_new, h, K_step, ops, consts, sta
                              slots, free_q, free_u, drive_q, drive_u, tree, body, loads, ws,
                              fail, nfev)
     return F, st
-
-
-def dense_values(F, y_old, x):
-    """The dense polynomial at the fractions ``x`` (array) of the step: ``(len(x), n)``."""
-    x = np.atleast_1d(np.asarray(x, dtype=float))[:, None]
-    acc = np.zeros((x.shape[0], F.shape[1]))
-    for r in range(F.shape[0] - 1, -1, -1):
-        acc += F[r]
-        acc *= x if r % 2 == 0 else 1.0 - x
-    return y_old + acc
