@@ -20,7 +20,7 @@ def raise_singular(model, q, t, pivot):
     model._jourdain_terms(q, np.zeros(model.nu), t)   # M at q (whatever route failed)
     M = model._M
     if not np.all(np.isfinite(M)):   # a NaN pivot: the input, not the inertia
-        model._require_finite(q, model._ufull[model._free_u] if model._driven else
+        model._require_finite(q, model._ufull[model._free_u] if model._time_inputs else
                              model._ufull, t)
         model._check_finite(q, np.zeros(model.nu), t, M.reshape(-1), "the mass matrix",
                            names=[f"M[{i},{j}]" for i in range(model.nu)
@@ -46,7 +46,7 @@ def _raise_at_pivot(model, q, t, pivot):
     """``raise_singular`` above ``CONDITION_SPEEDS`` free speeds: the degree of freedom
     where the elimination broke down is named without ``M``, whose nu x nu floats and
     O(nu^3) eigenvalues the O(n) routes never need (1.6 GB and minutes at 10,000 speeds)."""
-    model._require_finite(q, model._ufull[model._free_u] if model._driven else
+    model._require_finite(q, model._ufull[model._free_u] if model._time_inputs else
                           model._ufull, t)
     names = [model.speeds[pivot]]
     raise SingularMassMatrixError(

@@ -38,16 +38,23 @@ def momentum(model, q, u, t=0.0):
 
 def element_energy(model, q, u, t=0.0):
     """Force elements' ``(potential energy, non-conservative power)``: the energy stored
-    in springs and contacts, and the power dampers, friction, bushings and bearings
-    deliver to the system (negative when they take energy out)."""
+    in springs, stops and contacts, and the power dampers, friction, bushings, bearings
+    and actuators deliver to the system (negative when they take energy out)."""
+    V, P_nc, P_act = element_power(model, q, u, t)
+    return V, P_nc + P_act
+
+
+def element_power(model, q, u, t=0.0):
+    """``(potential energy, non-conservative power, actuators' power)`` of the force
+    elements: ``element_energy`` with what the actuators put in apart."""
     if not model.forces:
-        return 0.0, 0.0
+        return 0.0, 0.0, 0.0
     model._kinematics_kernel(q, u, t)
-    acc = np.zeros(2)
+    acc = np.zeros(3)
     kf.force_elements(model._force_int, model._force_data, model._parent, model._axis,
                       model._com, model._qfull, model._ufull, model._R, model._r, model._w,
                       model._v, model._F, model._N, acc, model._scratch)
-    return float(acc[0]), float(acc[1])
+    return float(acc[0]), float(acc[1]), float(acc[2])
 
 
 def load_power(model, q, u, t=0.0):

@@ -19,7 +19,7 @@ def fill(model, q, u, t):
     if q.shape != (model.nq,) or u.shape != (model.nu,):
         raise ModelError(f"model {model.name!r} expects q of length {model.nq} and u of "
                          f"length {model.nu}, got {q.shape} and {u.shape}")
-    if model._driven:
+    if model._time_inputs:
         model._qfull[model._free_q] = q
         model._ufull[model._free_u] = u
     else:                             # every joint is free: the layouts coincide
@@ -59,7 +59,7 @@ def state(model, q, u):
 
 def fill_inputs(model, q, u, t):
     """The drives' values and the loads given as Python functions, at ``t``."""
-    for name, kq, ku, drive in model._driven:
+    for name, kq, ku, drive in model._time_inputs:
         model._qfull[kq] = drive.position(t)
         model._ufull[ku] = drive.velocity(t)
         model._udfull[ku] = drive.acceleration(t)

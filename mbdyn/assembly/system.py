@@ -23,6 +23,7 @@ from ..elements.loads import make_load
 from ..errors import ModelError, ModelWarning, SingularMassMatrixError
 from ..limits import magnitude_problem
 from ..names import identifier_problem, label_problem
+from .actuation import add_actuator, add_controller, check_joint
 from .composite import add_composite_joint
 from .loops import add_loop_joint, check_loops, loop_bodies
 from ..elements.forces import GLOBAL_EFFECTS, make_force
@@ -77,6 +78,7 @@ class System:
         self._state_names = set()     # the joints' coordinates and speeds
         self._loads = {}
         self._forces = {}
+        self._controllers = {}          # name -> Controller (assembly.actuation)
 
     # ------------------------------------------------------------------ building
     def symbols(self, names):
@@ -254,8 +256,28 @@ class System:
         if kind == "joint-spring-damper" and el.params["joint"] not in self._joints:
             raise ModelError(f"force {name!r}: unknown joint {el.params['joint']!r}; add it "
                              f"first (known: {', '.join(self._joints) or 'none'})")
+        if kind == "joint-stop":
+            check_joint(self, f"force {name!r}", el.params["joint"])
         self._forces[name] = el
         return name
+
+    def add_actuator(self, name, joint, kind="torque", **params):
+        """A joint actuator (``mbdyn.elements.actuators``): an effort on the coordinate of
+        a revolute or prismatic ``joint``, equal and opposite on child and parent.
+        ``kind``: ``"torque"`` (``value``: number, expression of ``t``, coordinates,
+        speeds and parameters, or a table of ``t``), ``"motor"`` (``stall_torque``,
+        ``no_load_speed`` or ``torque_speed``; ``gear``, ``command``, ``rotor_inertia``),
+        ``"pd"``/``"pid"`` (``kp``, ``kd``, ``ki``, ``setpoint``, ``rate``,
+        ``gravity_compensation``, ``anti_windup``); every kind takes ``limit``.  A named
+        effect; compiled (no Python per step)."""
+        return add_actuator(self, name, joint, kind, **params)
+
+    def add_controller(self, name, function, rate, joints, limit=None):
+        """A controller in Python, ``function(t, q, u) -> efforts`` (one per joint of
+        ``joints``), called ``rate`` times a second; its efforts are held between calls
+        (zero-order hold) by one actuator per joint, named ``NAME_JOINT``, so that the
+        integration between samples stays compiled."""
+        return add_controller(self, name, function, rate, joints, limit)
 
     def effect_names(self):
         """Every effect of the system: ``gravity``, ``gyroscopic``, loads, force elements."""
@@ -317,7 +339,9 @@ class System:
                       warnings=found, parameters=self.parameters,
                       gravity_symbolic=self.gravity_symbolic if state["gravity"] else None,
                       forces=[el for el in self._forces.values() if state[el.name]],
-                      effects=state, loop_joints=loop_joints)
+                      effects=state, loop_joints=loop_joints,
+                      controllers=[c for c in self._controllers.values()
+                                   if any(state[a] for a in c.actuators)])
         if check_inertia and model.nu and not loop_joints:
             _check_inertia_of_every_dof(model)
         model.loops = {j.name: loop_bodies(self, j) for j in loop_joints}

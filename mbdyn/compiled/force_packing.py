@@ -10,6 +10,8 @@ import numpy as np
 from ..errors import ModelError
 from ..elements.forces import BEARING_COEFFICIENTS, Table
 from ..kernels import forces as kf
+from ..kernels.actuation import PROGRAM
+from .actuator_packing import law_block, pack_actuator, pack_joint_stop
 
 
 def _frame(model, name, element):
@@ -60,7 +62,8 @@ def pack_forces(model, forces):
     rows, data, laws = [], _Data(), []
     for el in forces:
         row = [0] * kf.ROW
-        _PACKERS[el.kind](model, el, f"force {el.name!r}", row, data, laws)
+        what = "actuator" if el.kind == "actuator" else "force"
+        _PACKERS[el.kind](model, el, f"{what} {el.name!r}", row, data, laws)
         rows.append(row)
     force_int = np.array(rows, np.int64).reshape(len(rows), kf.ROW)
     force_data = np.array(data.values, float)
@@ -86,9 +89,7 @@ def _spring_damper(model, el, element, row, data, laws):
     row[:4] = [kf.SPRING_DAMPER, ia, ib, off]
     row[4:6] = data.put_table(p["force_table"])
     row[6:8] = data.put_table(p["damping_table"])
-    if p.get("law") is not None:
-        row[5] = kf.LAW
-        laws.append((el, off + 9, p["law"]))
+    _law(row, data, laws, el, off + 9, p.get("law"))
 
 
 def _joint_spring_damper(model, el, element, row, data, laws):
@@ -109,9 +110,20 @@ def _joint_spring_damper(model, el, element, row, data, laws):
     row[4:6] = data.put_table(p["force_table"])
     row[6:8] = data.put_table(p["damping_table"])
     row[8:10] = [int(model._qoff[i]), int(model._uoff[i])]
-    if p.get("law") is not None:
+    _law(row, data, laws, el, off + 3, p.get("law"))
+
+
+def _law(row, data, laws, el, slot, law):
+    """A force law: compiled (a program, ``kernels.actuation``) when the stack machine can
+    evaluate it, else evaluated in Python before each evaluation into ``slot``."""
+    if law is None:
+        return
+    block = law_block(law)
+    if block is not None:
+        row[4:6] = data.put(block), PROGRAM
+    else:
         row[5] = kf.LAW
-        laws.append((el, off + 3, p["law"]))
+        laws.append((el, slot, law))
 
 
 def _bushing(model, el, element, row, data, laws):
@@ -157,7 +169,8 @@ def _contact(model, el, element, row, data, laws):
 
 #: each force-element kind's packer: its row of integers and its numbers in the data
 _PACKERS = {"spring-damper": _spring_damper, "joint-spring-damper": _joint_spring_damper,
-            "bushing": _bushing, "bearing": _bearing, "contact": _contact}
+            "bushing": _bushing, "bearing": _bearing, "contact": _contact,
+            "actuator": pack_actuator, "joint-stop": pack_joint_stop}
 
 
 def warn_outside_tables(model, t, u):

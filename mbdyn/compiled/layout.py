@@ -17,7 +17,12 @@ from ..kernels import evaluate as ke
 from ..kernels import joints as kj
 from ..kernels import packed as kp
 from ..kernels.constraints import constraint_count
+from ..elements.joints import make_drive
+from ..elements.values import t as TIME
 from .constraint_packing import pack_constraints
+
+#: the clock: a drive whose value is the time
+CLOCK = make_drive(TIME, "the clock")
 
 
 def tree(model, joints):
@@ -32,11 +37,14 @@ def tree(model, joints):
     model._C = np.array([j.orientation for j in joints], float).reshape(n, 3, 3)
 
 
-def coordinates(model, joints):
+def coordinates(model, joints, clock=False):
     """Where each joint's coordinates and speeds sit: offsets into the joint-space vectors
     (every joint) and columns of the free ``u`` (free joints only); the free coordinates'
     and speeds' names and indices; the driven joints, quaternion slices, the free joints'
-    slots for ``q' = N(q) u`` and the Euler joints' middle angles."""
+    slots for ``q' = N(q) u`` and the Euler joints' middle angles.  With ``clock`` (force
+    elements that read the time) the joint-space vectors end with the clock's entry,
+    filled like a drive's with ``t``, 1, 0: ``model._time_inputs`` lists the drives and
+    the clock, whatever writes into joint space at each evaluation's time."""
     n = len(joints)
     qoff = np.zeros(n, np.int64)
     uoff = np.zeros(n, np.int64)
@@ -62,6 +70,13 @@ def coordinates(model, joints):
             speeds.extend(j.speeds)
         nqf += j.nq
         nuf += j.nu
+    model._clock = None
+    model._time_inputs = list(model._driven)
+    if clock:
+        model._clock = (nqf, nuf)
+        model._time_inputs.append(("t", nqf, nuf, CLOCK))
+        nqf += 1
+        nuf += 1
     model._nq_full, model._nu_full = nqf, nuf
     model._qoff, model._uoff, model._ucol = qoff, uoff, ucol
     model._free_q = np.array(free_q, np.int64)

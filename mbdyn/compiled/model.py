@@ -24,6 +24,7 @@ from ..algorithms import newton_euler as ne
 from ..algorithms import reactions as joint_reactions
 from ..errors import ModelError
 from . import layout, states
+from .actuator_packing import reads_time, reflect_rotors, samplers
 from .force_packing import pack_forces
 
 
@@ -35,7 +36,8 @@ class Model:
     """
 
     def __init__(self, name, bodies, joints, loads, gravity, warnings=(), parameters=None,
-                 gravity_symbolic=None, forces=(), effects=None, loop_joints=()):
+                 gravity_symbolic=None, forces=(), effects=None, loop_joints=(),
+                 controllers=()):
         self.name = name
         self.warnings = tuple(warnings)
         self.gravity = np.array(gravity, dtype=float)
@@ -51,8 +53,9 @@ class Model:
         self._frame_index = {nm: i for i, nm in enumerate(self.frames)}
         self.n_frames = len(bodies)
         layout.tree(self, joints)
-        layout.coordinates(self, joints)
+        layout.coordinates(self, joints, clock=reads_time(forces))
         layout.bodies(self, bodies)
+        reflect_rotors(self, forces)
         layout.reactions(self, joints)
         load_functions = layout.loads(self, loads)
         # -- force elements and the effects the scene chose (only what is on is here)
@@ -76,7 +79,11 @@ class Model:
         self._laws = laws
         #: drives, function loads or force laws: values Python writes before each compiled
         #: evaluation
-        self._python_inputs = bool(self._driven or self._load_functions or self._laws)
+        self._python_inputs = bool(self._time_inputs or self._load_functions or self._laws)
+        #: controllers in Python and PID integral terms, updated at their sampling
+        #: instants between compiled stretches (``integrate.sampled``)
+        self._controllers = tuple(controllers)
+        self._samplers = samplers(self, controllers)
         layout.argument_groups(self)
         layout.constraints(self, loop_joints)
 
@@ -186,6 +193,7 @@ class Model:
     energy = energies.energy
     momentum = energies.momentum
     element_energy = energies.element_energy
+    element_power = energies.element_power
     load_power = energies.load_power
     euler_singularity = diagnosis.euler_singularity
     # closed loops (``algorithms.constrained``, ``algorithms.closure``)
@@ -235,8 +243,8 @@ class Model:
 
     def drive_values(self, times):
         """``(len(times), n_drives, 3)``: each drive's ``q, q', q''`` at ``times``."""
-        out = np.empty((len(times), len(self._driven), 3))
-        for d, (_, _, _, drive) in enumerate(self._driven):
+        out = np.empty((len(times), len(self._time_inputs), 3))
+        for d, (_, _, _, drive) in enumerate(self._time_inputs):
             for k, tk in enumerate(times):
                 out[k, d] = drive.position(tk), drive.velocity(tk), drive.acceleration(tk)
         return out
@@ -248,8 +256,8 @@ class Model:
         choose their route by the workspace's layout, ``integrators.accelerations``)."""
         slots = self._slots
         quats = np.array([s.start for s in self._quaternions], np.int64)
-        drive_q = np.array([d[1] for d in self._driven], np.int64)
-        drive_u = np.array([d[2] for d in self._driven], np.int64)
+        drive_q = np.array([d[1] for d in self._time_inputs], np.int64)
+        drive_u = np.array([d[2] for d in self._time_inputs], np.int64)
         body = (self._mass, self._com, self._inertia, self._has_inertia, self.gravity)
         if method == "jourdain":
             self._full_workspace()

@@ -102,6 +102,23 @@ def condition_program(g, variables):
     return np.array(ops, np.int64).reshape(-1, 2), np.array(consts, float)
 
 
+def program_block(expr, codes):
+    """The numbers of ``expr`` as a program stored among a force element's numbers
+    (``kernels.actuation.program_value``): ``[n_ops, n_consts, n_vars, ops, consts,
+    variable codes]``; ``codes``: ``{symbol name: variable code}`` of the symbols it may
+    read besides ``t``.  ``None`` when the stack machine cannot evaluate ``expr``."""
+    from ..kernels.actuation import MAX_VARS
+    names = sorted(s.name for s in expr.free_symbols if s.name != "t")
+    if any(n not in codes for n in names) or len(names) > MAX_VARS:
+        return None
+    program = condition_program(expr, {n: k for k, n in enumerate(names)})
+    if program is None:
+        return None
+    ops, consts = program
+    return np.concatenate([[len(ops), len(consts), len(names)], ops.reshape(-1).astype(float),
+                           consts, [float(codes[n]) for n in names]])
+
+
 class EventPrograms:
     """The conditions of a run's events as one set of programs (``kernels.events``), or
     ``of(events)`` is ``None`` when one of them has no program (a Python function, or an

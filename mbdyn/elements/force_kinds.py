@@ -10,6 +10,7 @@ import functools
 import numpy as np
 
 from ..errors import ModelError
+from .actuators import joint_stop
 from .force_values import make_law
 from .tables import Table, make_table
 from .values import numeric, parse_axis
@@ -286,4 +287,5 @@ def hunt_crossley_factor(restitution, exponent):
 
 #: kind -> builder, in the order the kinds are listed
 BUILDERS = {"spring-damper": spring_damper, "joint-spring-damper": joint_spring_damper,
-            "bushing": bushing, "bearing": bearing, "contact": contact}
+            "bushing": bushing, "bearing": bearing, "contact": contact,
+            "joint-stop": joint_stop}

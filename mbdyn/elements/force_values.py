@@ -92,6 +92,9 @@ class Law:
     ``v`` and the system's parameters) when it was given as one, for the symbolic layer."""
     function: object
     expression: object = None
+    #: the expression with the parameters' values in, in the symbols ``x`` and ``v`` (what
+    #: compiled code evaluates: ``compiled.programs``)
+    numeric: object = None
 
     def __call__(self, x, v):
         return self.function(x, v)
@@ -117,4 +120,4 @@ def make_law(law, parameters, element):
     numeric_law = numeric_law.subs({s: (xs if s.name == "x" else vs)
                                     for s in numeric_law.free_symbols})
     fn = sympy.lambdify((xs, vs), numeric_law, "math")
-    return Law(lambda x, v: float(fn(x, v)), law)
+    return Law(lambda x, v: float(fn(x, v)), law, numeric_law)

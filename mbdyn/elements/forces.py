@@ -12,6 +12,10 @@ Kinds (``System.add_force(name, kind, ...)``):
   ``kxx, kxy, kyx, kyy, cxx, cxy, cyx, cyy``, constant or tabulated against the spin speed.
 * ``contact``  a sphere (or a disk's rim) of a body against a plane fixed in the world:
   Hunt-Crossley normal force and regularised Coulomb friction.
+* ``joint-stop``  a one-sided spring-damper at the bounds of a joint's coordinate.
+
+Actuators (``System.add_actuator``, ``mbdyn.elements.actuators``) are force elements of
+kind ``actuator`` too: one namespace, each a named effect.
 
 Tables are interpolated monotonically: ``"pchip"`` (piecewise-cubic Hermite that keeps
 monotone data monotone; the default) or ``"linear"``; never a smoothing spline.
@@ -26,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ModelError
+from .actuators import make_actuator
 from ..names import identifier_problem
 from .force_kinds import (BEARING_COEFFICIENTS, BUILDERS, hunt_crossley_factor,  # noqa: F401
                           radial_directions)
@@ -73,6 +78,11 @@ class ForceElement:
             law = ("table" if p["force_table"] is not None else
                    f"k = {p['stiffness']:g}, rest {p['rest']:g}")
             return f"on joint {p['joint']!r}: {law}, c = {p['damping']:g}"
+        if self.kind == "joint-stop":
+            return (f"on joint {p['joint']!r}: stops at {p['lower']:g} and {p['upper']:g}, "
+                    f"k = {p['stiffness']:g}, c = {p['damping']:g}")
+        if self.kind == "actuator":
+            return describe_actuator(p)
         if self.kind == "bushing":
             return f"{self.frames[0]} -- {self.frames[1]}: 6x6 stiffness and damping"
         if self.kind == "bearing":
@@ -84,6 +94,47 @@ class ForceElement:
                 f"plane through {tuple(p['plane_point'].tolist())}, normal "
                 f"{tuple(np.round(p['plane_normal'], 6).tolist())}; k = {p['stiffness']:g}, "
                 f"e = {p['restitution']:g}, mu = {p['friction']:g}")
+
+
+def describe_actuator(p):
+    """One line for ``mbdyn info`` of an actuator's parameters ``p``."""
+    kind = p["type"]
+    sat = "" if p["limit"] == float("inf") else f", limit {p['limit']:g}"
+    if kind == "torque":
+        what = f"effort {_signal_text(p['value'])}"
+    elif kind == "held":
+        what = "effort held by a sampled controller"
+    elif kind == "motor":
+        line = ("torque-speed table" if p["torque_speed"] is not None else
+                f"stall torque {p['stall_torque']:g}, no-load speed {p['no_load_speed']:g}")
+        what = (f"motor ({line}, gear {p['gear']:g}, command {_signal_text(p['command'])}"
+                + (f", rotor inertia {p['rotor_inertia']:g}" if p["rotor_inertia"] else "")
+                + ")")
+    else:
+        what = (f"{kind.upper()} kp = {p['kp']:g}, kd = {p['kd']:g}"
+                + (f", ki = {p['ki']:g} at {p['rate']:g} Hz" if kind == "pid" else "")
+                + f", setpoint {_signal_text(p['setpoint'])}"
+                + (", gravity compensated" if p["gravity_compensation"] else ""))
+    return f"on joint {p['joint']!r}: {what}{sat}"
+
+
+def _signal_text(value):
+    return ("a table of t" if isinstance(value, Table) else
+            f"{value:g}" if isinstance(value, float) else str(value))
+
+
+def actuator(name, joint, kind, parameters=None, **kw):
+    """Validate and build an actuator (a ``ForceElement`` of kind ``actuator``)."""
+    problem = identifier_problem(name)
+    if problem:
+        raise ModelError(f"actuator {name!r}: the name {problem}; it names the element's "
+                         "effect")
+    if name in GLOBAL_EFFECTS:
+        raise ModelError(f"actuator {name!r}: the name is reserved for the {name} effect; "
+                         "choose another")
+    symbolic = {k: v for k, v in kw.items() if not isinstance(v, str) and has_symbols(v)}
+    params = make_actuator(name, joint, kind, parameters, **kw)
+    return ForceElement(name, "actuator", (), params, symbolic)
 
 
 def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):

@@ -52,7 +52,7 @@ class Table:
 
     def __call__(self, x):
         """The interpolant at ``x`` (numpy; for reports and tests)."""
-        from ..kernels.forces import table_eval
+        from ..kernels.tables import table_eval
         blk = self.block()
         out = np.empty(3)
         table_eval(blk, 0, self.mode, float(x), out)

@@ -3,8 +3,8 @@
 ``T + V + dissipated - work`` is constant along an exact motion, where ``V`` is the
 gravitational potential plus the energy stored in springs and contacts, ``dissipated``
 what dampers, friction, bushings and bearings took out (``-`` the time integral of their
-non-conservative power) and ``work`` what loads and drives put in (the time integral of
-their power).  The two integrals are taken over the stored samples by Simpson's rule, so
+non-conservative power) and ``work`` what loads, drives and actuators put in (the time
+integral of their power).  The two integrals are taken over the stored samples by Simpson's rule, so
 the balance's drift includes that quadrature error as well as the integrator's: store
 samples densely (``t_eval``, ``output_dt``) for a tight check.
 """
@@ -70,8 +70,9 @@ def energy_balance(model, t, q, u):
     for k in range(n):
         T[k], V[k] = model.energy(q[k], u[k], t[k])
         if model.forces:
-            v_el, P_nc[k] = model.element_energy(q[k], u[k], t[k])
+            v_el, P_nc[k], P_act = model.element_power(q[k], u[k], t[k])
             V[k] += v_el
+            P_in[k] += P_act
         if model.loads:
             P_in[k] += model.load_power(q[k], u[k], t[k])
         if drives:

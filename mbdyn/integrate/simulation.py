@@ -19,13 +19,14 @@ import numpy as np
 from ..algorithms.forward_dynamics import METHODS as _METHODS
 from ..compiled.force_packing import warn_outside_tables
 from ..errors import ModelError, ModelWarning, SimulationError
-from . import compiled_adaptive, fixed_step, scipy_solvers
+from . import compiled_adaptive, fixed_step, sampled, scipy_solvers
 from .budget import check_fixed_step, make_budget
 from .closed_loops import closed_initial_state, loop_report, release_rank
 from .events import Event, as_event, check_conditions
 from .monitor import Monitor, conditioning
 from .plan import Plan, RightHandSide
 from .result import Result
+from .sampled import is_sampled
 from .settings import ADAPTIVE, COMPILED_ADAPTIVE, DEFAULTS, FIXED_STEP, INTEGRATORS
 
 
@@ -114,7 +115,10 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     plan = Plan(rhs, integrator, t0, t_end, y0, events, t_eval, progress, monitor, budget,
                 rtol, atol, max_step, dt if integrator not in ADAPTIVE else None)
     try:
-        outcome = _integrate(plan, compiled_loop)
+        if is_sampled(model):
+            outcome = sampled.run(plan, lambda sub: _integrate(sub, compiled_loop))
+        else:
+            outcome = _integrate(plan, compiled_loop)
     finally:
         if model.has_loops:
             release_rank(model)
@@ -246,7 +250,7 @@ def _integrate(plan, compiled_loop):
         return fixed_step.run(plan, compiled)
     if compiled and plan.integrator in COMPILED_ADAPTIVE and plan.y0.size > 0:
         from ..compiled.programs import drive_programs
-        programs = drive_programs([d[3] for d in model._driven])
+        programs = drive_programs([d[3] for d in model._time_inputs])
         if programs is not None:
             return compiled_adaptive.run(plan, programs)
     return scipy_solvers.run(plan)

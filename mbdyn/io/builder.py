@@ -21,7 +21,7 @@ from .events import read_events
 from .expressions import ExpressionError, parse, symbol, to_float
 from .initial import read_initial
 from .settings import read_outputs, read_simulation
-from .system_sections import add_bodies, add_forces, add_joints, add_loads
+from .system_sections import add_actuators, add_bodies, add_forces, add_joints, add_loads
 from .urdf.section import add_section, read_section
 
 
@@ -173,7 +173,7 @@ class SceneBuilder:
         self.PTQ = dict(self.PT)
         self.PTQ.update(self.names_q)
         self.load_specs = add_loads(self)
-        self.force_specs = add_forces(self)
+        self.force_specs = add_forces(self) + add_actuators(self)
         return system
 
     def parameters(self):

@@ -36,7 +36,8 @@ SIMULATION_KEYS = {"t_end": "expr", "integrator": "string", "method": "string",
 OUTPUT_KEYS = {"reactions": "reactions", "reactions_frame": ("choice", ("world", "child")),
                "energy": "bool", "points": "points"}
 POINT_KEYS = {"frame": "name", "offset": "vector"}
-FORCE_KINDS = ("spring-damper", "joint-spring-damper", "bushing", "bearing", "contact")
+FORCE_KINDS = ("spring-damper", "joint-spring-damper", "bushing", "bearing", "contact",
+               "joint-stop")
 FORCE_KEYS = {"name": "name", "kind": ("choice", FORCE_KINDS),
               "body_a": "name", "point_a": "vector", "body_b": "name", "point_b": "vector",
               "body": "name", "point": "vector", "housing": "name", "center": "vector",
@@ -51,7 +52,15 @@ FORCE_KEYS = {"name": "name", "kind": ("choice", FORCE_KINDS),
               "radius": "expr", "shape": ("choice", ("sphere", "disk")),
               "plane_point": "vector", "plane_normal": "axis", "exponent": "expr",
               "restitution": "expr", "impact_speed": "expr", "friction": "expr",
-              "slip_speed": "expr"}
+              "slip_speed": "expr", "lower": "expr", "upper": "expr"}
+ACTUATOR_KINDS = ("torque", "motor", "pd", "pid")
+ACTUATOR_KEYS = {"name": "name", "joint": "name", "kind": ("choice", ACTUATOR_KINDS),
+                 "value": "signal", "setpoint": "signal", "command": "signal",
+                 "kp": "expr", "kd": "expr", "ki": "expr", "limit": "expr", "rate": "expr",
+                 "anti_windup": "bool", "gravity_compensation": "bool",
+                 "stall_torque": "expr", "no_load_speed": "expr", "torque_speed": "table",
+                 "gear": "expr", "rotor_inertia": "expr",
+                 "interpolation": ("choice", ("pchip", "linear"))}
 EFFECT_KEYS = {"gravity": "bool", "gyroscopic": "bool", "off": "names", "on": "names"}
 EVENT_KEYS = {"name": "name", "condition": "condition", "terminal": "bool",
               "direction": "direction"}
@@ -65,6 +74,7 @@ SECTIONS = {
     "joints": ("array", JOINT_KEYS),
     "loads": ("array", LOAD_KEYS),
     "forces": ("array", FORCE_KEYS),
+    "actuators": ("array", ACTUATOR_KEYS),
     "effects": ("table", EFFECT_KEYS),
     "initial": ("map", None),
     "initial_speeds": ("map", None),
@@ -75,5 +85,5 @@ SECTIONS = {
     "cases": ("cases", None),
 }
 ARRAY_ELEMENT = {"bodies": "body", "joints": "joint", "loads": "load", "forces": "force",
-                 "events": "event"}
+                 "actuators": "actuator", "events": "event"}
 DIRECTIONS = {"rising": 1, "falling": -1, "either": 0}

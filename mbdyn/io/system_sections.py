@@ -271,3 +271,36 @@ def _force_value(b, key, value, path):
     if isinstance(value, list):         # numbers, rows of numbers, [x, y] table rows
         return b.numbers(value, path)
     return b.pval(value, path)
+
+
+# ---------------------------------------------------------------- [[actuators]]
+#: an actuator's keys read as sources: a number, an expression (of t, the free coordinates
+#: and speeds, and parameters) or a table of t
+ACTUATOR_SIGNALS = ("value", "setpoint", "command")
+
+
+def add_actuators(b):
+    """``[[actuators]]``: each table's keys handed to ``System.add_actuator``."""
+    specs = []
+    for path, act, name in b.entries("actuators", "actuator"):
+        joint = b.required(act, "joint", path, "actuator")
+        kw = {}
+        for key, value in act.items():
+            at = path + (key,)
+            if key in ("name", "joint", "kind", "interpolation", "gravity_compensation",
+                       "anti_windup"):
+                if key not in ("name", "joint", "kind"):
+                    kw[key] = value
+            elif key in ACTUATOR_SIGNALS and isinstance(value, list):
+                kw[key] = b.numbers(value, at)
+            elif key in ACTUATOR_SIGNALS:
+                e = b.expr(value, at, b.PTQ)
+                kw[key] = e if e.free_symbols else b.number(value, at)
+            elif key == "torque_speed":
+                kw[key] = b.numbers(value, at)
+            else:
+                kw[key] = b.pval(value, at)
+        with b.engine(path):
+            b.system.add_actuator(name, joint, act.get("kind", "torque"), **kw)
+        specs.append(dict(act))
+    return specs

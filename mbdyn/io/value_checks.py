@@ -180,6 +180,14 @@ def _table(c, value, path):
         c.check_expr(y, path + (i, 1))
 
 
+def _signal(c, value, path):
+    """A number, an expression, or a table of t (an actuator's value or setpoint)."""
+    if isinstance(value, list):
+        _table(c, value, path)
+    else:
+        c.check_expr(value, path)
+
+
 def _points(c, value, path):
     if not isinstance(value, dict):
         raise c.error(path, "must be a table of points: NAME = { frame = \"...\", offset "
@@ -197,4 +205,4 @@ CHECKS = {"string": _string, "name": _name, "bool": _boolean, "expr": _expressio
           "names": _names, "condition": _condition, "direction": _direction,
           "reactions": _reactions, "shape": _shape, "exprs": _expressions,
           "coefficient": _coefficient, "matrix6": _matrix6, "table": _table,
-          "points": _points}
+          "points": _points, "signal": _signal}

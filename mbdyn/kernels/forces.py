@@ -18,68 +18,25 @@ or holds its end value (``clamp``).
 
 With ``acc`` (two entries) an element also adds its potential energy to ``acc[0]`` and
 the power of its non-conservative part (what dampers and friction take out, negative) to
-``acc[1]``.
+``acc[1]``; with three, the actuators' power goes to ``acc[2]`` instead.
 """
 import math
 
 from numba import njit
 
+from .actuation import PROGRAM, PROGRAM_WORK, actuator_effort, program_value, stop_effort
 from .linalg3 import cross_to, mat_t_vec, mat_vec
+from .tables import LINEAR, NO_TABLE, PCHIP, table_eval  # noqa: F401
 from .views import UNCOUNTED
 
-SPRING_DAMPER, JOINT_SPRING_DAMPER, BUSHING, BEARING, CONTACT_SPHERE, CONTACT_DISK = 1, 2, 3, 4, 5, 6
+(SPRING_DAMPER, JOINT_SPRING_DAMPER, BUSHING, BEARING, CONTACT_SPHERE, CONTACT_DISK, ACTUATOR,
+ JOINT_STOP) = 1, 2, 3, 4, 5, 6, 7, 8
 KIND_CODES = {"spring-damper": SPRING_DAMPER, "joint-spring-damper": JOINT_SPRING_DAMPER,
-              "bushing": BUSHING, "bearing": BEARING, "contact": CONTACT_SPHERE}
-NO_TABLE, LINEAR, PCHIP, LAW = 0, 1, 2, 3      # LAW: a law evaluated in Python, given as preload
+              "bushing": BUSHING, "bearing": BEARING, "contact": CONTACT_SPHERE,
+              "actuator": ACTUATOR, "joint-stop": JOINT_STOP}
+LAW = 3          # a law evaluated in Python, given as preload (PROGRAM = 4: compiled)
 ROW = 10          # entries of a force_int row
-FORCE_WORK = 74   # floats of scratch ``force_elements`` needs
-
-
-@njit(**UNCOUNTED)
-def table_eval(data, off, mode, x, out):
-    """Interpolated value, slope and integral (from the first knot) at ``x`` into
-    ``out[0:3]``."""
-    n = int(data[off])
-    clamp = data[off + 1] != 0.0
-    X = off + 2
-    Y = X + n
-    D = Y + n
-    I = D + n
-    x0, xn = data[X], data[X + n - 1]
-    if x <= x0 or x >= xn:
-        k = 0 if x <= x0 else n - 1
-        y, d = data[Y + k], data[D + k]
-        if clamp:
-            d = 0.0
-        dx = x - data[X + k]
-        out[0] = y + d * dx
-        out[1] = d
-        out[2] = data[I + k] + y * dx + 0.5 * d * dx * dx
-        return
-    lo, hi = 0, n - 1
-    while hi - lo > 1:                  # bisection for x_lo <= x < x_hi
-        mid = (lo + hi) // 2
-        if data[X + mid] <= x:
-            lo = mid
-        else:
-            hi = mid
-    h = data[X + hi] - data[X + lo]
-    s = (x - data[X + lo]) / h
-    y0, y1 = data[Y + lo], data[Y + hi]
-    if mode == LINEAR:
-        out[0] = y0 + s * (y1 - y0)
-        out[1] = (y1 - y0) / h
-        out[2] = data[I + lo] + h * (y0 * s + 0.5 * (y1 - y0) * s * s)
-        return
-    d0, d1 = data[D + lo] * h, data[D + hi] * h
-    s2, s3 = s * s, s * s * s
-    out[0] = (2 * s3 - 3 * s2 + 1) * y0 + (s3 - 2 * s2 + s) * d0 + (-2 * s3 + 3 * s2) * y1 \
-        + (s3 - s2) * d1
-    out[1] = ((6 * s2 - 6 * s) * y0 + (3 * s2 - 4 * s + 1) * d0 + (-6 * s2 + 6 * s) * y1
-              + (3 * s2 - 2 * s) * d1) / h
-    s4 = s2 * s2
-    out[2] = data[I + lo] + h * ((0.5 * s4 - s3 + s) * y0 + (0.25 * s4 - 2 * s3 / 3 + 0.5 * s2) * d0
-                                 + (-0.5 * s4 + s3) * y1 + (0.25 * s4 - s3 / 3) * d1)
+FORCE_WORK = 74 + PROGRAM_WORK   # floats of scratch ``force_elements`` needs
 
 
 @njit(**UNCOUNTED)
@@ -127,10 +84,15 @@ def _apply(i, p, f, m, sign, R, r, com, F, N, lever, t):
 
 
 @njit(**UNCOUNTED)
-def _law(data, spring_off, spring_mode, damper_off, damper_mode, k, c, F0, x, xd, tmp):
+def _law(data, spring_off, spring_mode, damper_off, damper_mode, k, c, F0, x, xd, tmp,
+         qfull, ufull, work):
     """Tension of a spring-damper law and the potential of its spring part:
-    ``(spring force, damper force, potential)``."""
-    if spring_mode == NO_TABLE:
+    ``(spring force, damper force, potential)``.  A law given as a program (``PROGRAM``)
+    is all spring force, its potential not known (its power counts as non-conservative)."""
+    if spring_mode == PROGRAM:
+        fs = F0 + program_value(data, spring_off, 0.0, x, xd, qfull, ufull, work)
+        V = 0.0
+    elif spring_mode == NO_TABLE:
         fs = F0 + k * x
         V = F0 * x + 0.5 * k * x * x
     elif spring_mode == LAW:            # the caller wrote law(x, x') into the preload slot
@@ -159,7 +121,7 @@ def force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r,
     # long: one branch per force-element kind in one compiled loop: a kernel per kind would be
     # one more compiled entry point per kind and a dispatch per element.
     want = acc.shape[0] >= 2
-    tmp, six = work[0:48], work[48:FORCE_WORK]
+    tmp, six, prog = work[0:48], work[48:74], work[74:FORCE_WORK]
     pa, pb, va, vb, d, f = tmp[0:3], tmp[3:6], tmp[6:9], tmp[9:12], tmp[12:15], tmp[15:18]
     m, lever, t, e1, e2, tab = tmp[18:21], tmp[21:24], tmp[24:27], tmp[27:30], tmp[30:33], tmp[33:36]
     x6, xd6, w6, ks = six[0:6], six[6:12], six[12:18], six[18:26]
@@ -184,7 +146,7 @@ def force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r,
                 d[q] *= scale
                 xd += d[q] * (vb[q] - va[q])
             fs, fd, V = _law(force_data, force_int[e, 4], force_int[e, 5], force_int[e, 6],
-                             force_int[e, 7], k_, c_, F0, L - L0, xd, tab)
+                             force_int[e, 7], k_, c_, F0, L - L0, xd, tab, qfull, ufull, prog)
             T = fs + fd                                 # tension pulls a towards b
             for q in range(3):
                 f[q] = T * d[q]
@@ -192,7 +154,7 @@ def force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r,
             _apply(ib, pb, f, zero, -1.0, R, r, com, F, N, lever, t)
             if want:
                 acc[0] += V
-                acc[1] -= (T if force_int[e, 5] == LAW else fd) * xd
+                acc[1] -= (T if force_int[e, 5] >= LAW else fd) * xd
         elif kind == JOINT_SPRING_DAMPER:
             # frame_a: the joint's child frame; index1/index2: joint-space q and u entries;
             # data: rest value, k, c, preload, prismatic (1) or revolute (0)
@@ -202,21 +164,28 @@ def force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r,
             xd = ufull[ku]
             fs, fd, V = _law(force_data, force_int[e, 4], force_int[e, 5], force_int[e, 6],
                              force_int[e, 7], force_data[off + 1], force_data[off + 2],
-                             force_data[off + 3], x, xd, tab)
-            tau = -(fs + fd)
-            mat_vec(R[i], axis[i], e1)
-            for q in range(3):
-                e1[q] *= tau
-                pa[q] = r[i, q]
-            if force_data[off + 4] != 0.0:      # prismatic: a force along the axis
-                _apply(i, pa, e1, zero, 1.0, R, r, com, F, N, lever, t)
-                _apply(parent[i], pa, e1, zero, -1.0, R, r, com, F, N, lever, t)
-            else:                               # revolute: a moment about the axis
-                _apply(i, pa, zero, e1, 1.0, R, r, com, F, N, lever, t)
-                _apply(parent[i], pa, zero, e1, -1.0, R, r, com, F, N, lever, t)
+                             force_data[off + 3], x, xd, tab, qfull, ufull, prog)
+            _joint_effort(i, parent[i], axis, force_data[off + 4] != 0.0, -(fs + fd), R, r,
+                          com, F, N, e1, pa, zero, lever, t)
             if want:
                 acc[0] += V
-                acc[1] -= ((fs + fd) if force_int[e, 5] == LAW else fd) * xd
+                acc[1] -= ((fs + fd) if force_int[e, 5] >= LAW else fd) * xd
+        elif kind == ACTUATOR or kind == JOINT_STOP:
+            # frame_a: the joint's child frame; index1/index2: joint-space q and u entries
+            i = ia
+            x, xd = qfull[force_int[e, 8]], ufull[force_int[e, 9]]
+            mat_vec(R[i], axis[i], e2)
+            if kind == ACTUATOR:
+                tau = actuator_effort(force_data, off, force_int[e], x, xd, qfull, ufull, i,
+                                      axis, com, R, r, e2, prog)
+                if want:        # what it puts in: apart in acc[2] when asked
+                    acc[2 if acc.shape[0] >= 3 else 1] += tau * xd
+                prismatic = force_data[off + 1] != 0.0
+            else:
+                tau = stop_effort(force_data, off, x, xd, acc, want)
+                prismatic = force_data[off + 4] != 0.0
+            _joint_effort(i, parent[i], axis, prismatic, tau, R, r, com, F, N, e1, pa, zero,
+                          lever, t)
         elif kind == BUSHING:
             # data: point_a(3), point_b(3), K (6x6 row-major), C (6x6), all in frame a's
             # axes; x = (translation, small rotation) of b relative to a
@@ -280,6 +249,23 @@ def force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r,
         else:
             _contact(kind, ia, off, force_data, R, r, w, v, com, F, N, acc, want,
                      pa, va, d, f, lever, t, e1, zero)
+
+
+@njit(**UNCOUNTED)
+def _joint_effort(i, p, axis, prismatic, tau, R, r, com, F, N, e, at, zero, lever, t):
+    """The effort ``tau`` on the coordinate of joint ``i`` (parent ``p``): a force along a
+    prismatic axis or a moment about a revolute one, on the child and, opposite, on the
+    parent, at the joint's origin."""
+    mat_vec(R[i], axis[i], e)
+    for q in range(3):
+        e[q] *= tau
+        at[q] = r[i, q]
+    if prismatic:
+        _apply(i, at, e, zero, 1.0, R, r, com, F, N, lever, t)
+        _apply(p, at, e, zero, -1.0, R, r, com, F, N, lever, t)
+    else:
+        _apply(i, at, zero, e, 1.0, R, r, com, F, N, lever, t)
+        _apply(p, at, zero, e, -1.0, R, r, com, F, N, lever, t)
 
 
 @njit(**UNCOUNTED)

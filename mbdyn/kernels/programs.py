@@ -7,7 +7,8 @@ constants ``consts``; ``mbdyn.compiled.programs`` writes them from sympy express
 ``y[k]`` (``y = [q, u]``), ``ADD n``/``MUL n``/``MIN n``/``MAX n`` replace the top ``n``
 values by their sum/product/least/greatest, ``POW`` replaces ``base, exponent`` by the
 power, ``ATAN2`` replaces ``y, x`` by ``atan2(y, x)``, the others apply a function of one
-value to the top.
+value to the top.  ``ops`` may be an integer array or a float array holding the same
+integers (an actuator's program stored among its element's numbers, ``kernels.actuation``).
 """
 import numpy as np
 from numba import njit
@@ -26,8 +27,8 @@ def evaluate(ops, consts, first, last, t, y, stack):
     # functions would be an indirect call per operation in compiled code).
     top = 0
     for k in range(first, last):
-        op = ops[k, 0]
-        arg = ops[k, 1]
+        op = int(ops[k, 0])             # int(): a program may be stored as floats
+        arg = int(ops[k, 1])
         if op == CONST:
             stack[top] = consts[arg]
             top += 1
