@@ -246,3 +246,39 @@ def test_actuator_refuses_what_it_cannot_act_on():
     s3.add_actuator("a", "th", "torque", value=sympy.Symbol("speed") * 2)
     with pytest.raises(ModelError, match="uses speed, which are neither"):
         s3.compile()
+
+
+def test_symbolic_equations_agree_with_the_kernels():
+    t_ = sympy.Symbol("t")
+    s = arm()
+    s.add_actuator("ctl", "th", "pd", kp=50.0, kd=3.0, setpoint=0.2 * sympy.sin(2 * t_),
+                   limit=20.0)
+    s.add_force("stop", "joint-stop", joint="th", lower=-0.3, upper=0.25, stiffness=1e4,
+                damping=20.0)
+    s.add_body("w", mass=0.5, inertia=(0.01, 0.01, 0.02))
+    s.add_joint("spin", "revolute", parent="arm", child="w", axis="z", position=(1, 0, 0))
+    s.add_actuator("push", "spin", "torque", value=0.3 * sympy.cos(t_)
+                   - 0.1 * sympy.Symbol("spin_dot"))
+    m = s.compile()
+    rng = np.random.default_rng(3)
+    rhs = mb.symbolic.compiled_rhs(m)
+    for _ in range(4):
+        q, u, t = rng.uniform(-0.5, 0.5, 2), rng.uniform(-1, 1, 2), rng.uniform(0, 2)
+        assert np.allclose(rhs.accelerations(q, u, t), m.forward_dynamics(q, u, t),
+                           rtol=1e-10, atol=1e-10)
+    s.add_actuator("i", "spin", "pid", kp=1.0, ki=1.0)
+    with pytest.raises(ModelError, match="actuator 'i'.*not PID integrals"):
+        mb.symbolic.compiled_rhs(s.compile()).accelerations(q, u, t)
+
+
+def test_generated_equations_are_not_reused_across_force_elements():
+    # the generated code's cache key once left force elements out: a model differing only
+    # in a spring's stiffness (or an actuator's gain) reused the first one's equations
+    out = []
+    for k in (10.0, 20.0):
+        s = wheel()
+        s.add_force("spring", "joint-spring-damper", joint="th", stiffness=k)
+        m = s.compile()
+        out.append(mb.symbolic.compiled_rhs(m).accelerations([0.1], [0.0]))
+        assert np.allclose(out[-1], m.forward_dynamics([0.1], [0.0]), rtol=1e-12)
+    assert out[0][0] != out[1][0]

@@ -1,6 +1,6 @@
-"""Actuators and sampled controllers added to a ``System``: the checks across elements
-(the joint exists and has one coordinate; names are free) that their records
-(``elements.actuators``) cannot make alone.
+"""Actuators, sampled controllers and force elements added to a ``System``: the checks
+across elements (the frames and joint exist, the joint has one free coordinate, names are
+free) that their records (``elements.actuators``, ``elements.forces``) cannot make alone.
 """
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ from ..elements.forces import actuator
 from ..errors import ModelError
 from ..names import identifier_problem
 
+GROUND = "ground"
 #: joint kinds an actuator or a stop acts on: one coordinate
 ONE_COORDINATE = ("revolute", "prismatic")
 
@@ -31,6 +32,21 @@ def check_joint(system, element, joint):
                          "an actuator needs a free coordinate -- remove the drive, or read "
                          "the drive's effort from the results")
     return j
+
+
+def check_force(system, el):
+    """A force element's frames and joint exist in ``system``."""
+    name = el.name
+    for frame in el.frames:
+        if frame != GROUND and frame not in system.graph:
+            raise ModelError(f"force {name!r}: unknown body {frame!r}; add it first with "
+                             f"add_body or add_frame (known: "
+                             f"{', '.join(n for n in system.graph if n != GROUND)}, ground)")
+    if el.kind == "joint-spring-damper" and el.params["joint"] not in system._joints:
+        raise ModelError(f"force {name!r}: unknown joint {el.params['joint']!r}; add it "
+                         f"first (known: {', '.join(system._joints) or 'none'})")
+    if el.kind == "joint-stop":
+        check_joint(system, f"force {name!r}", el.params["joint"])
 
 
 def add_actuator(system, name, joint, kind="torque", **params):

@@ -23,7 +23,7 @@ from ..elements.loads import make_load
 from ..errors import ModelError, ModelWarning, SingularMassMatrixError
 from ..limits import magnitude_problem
 from ..names import identifier_problem, label_problem
-from .actuation import add_actuator, add_controller, check_joint
+from .actuation import add_actuator, add_controller, check_force
 from .composite import add_composite_joint
 from .loops import add_loop_joint, check_loops, loop_bodies
 from ..elements.forces import GLOBAL_EFFECTS, make_force
@@ -248,35 +248,21 @@ class System:
                              "element or load; loads and force elements share one namespace "
                              "(their names are the scene's effects)")
         el = make_force(name, kind, self.parameters, self.gravity, **params)
-        for frame in el.frames:
-            if frame != GROUND and frame not in self.graph:
-                raise ModelError(f"force {name!r}: unknown body {frame!r}; add it first with "
-                                 f"add_body or add_frame (known: "
-                                 f"{', '.join(n for n in self.graph if n != GROUND)}, ground)")
-        if kind == "joint-spring-damper" and el.params["joint"] not in self._joints:
-            raise ModelError(f"force {name!r}: unknown joint {el.params['joint']!r}; add it "
-                             f"first (known: {', '.join(self._joints) or 'none'})")
-        if kind == "joint-stop":
-            check_joint(self, f"force {name!r}", el.params["joint"])
+        check_force(self, el)
         self._forces[name] = el
         return name
 
     def add_actuator(self, name, joint, kind="torque", **params):
-        """A joint actuator (``mbdyn.elements.actuators``): an effort on the coordinate of
-        a revolute or prismatic ``joint``, equal and opposite on child and parent.
-        ``kind``: ``"torque"`` (``value``: number, expression of ``t``, coordinates,
-        speeds and parameters, or a table of ``t``), ``"motor"`` (``stall_torque``,
-        ``no_load_speed`` or ``torque_speed``; ``gear``, ``command``, ``rotor_inertia``),
-        ``"pd"``/``"pid"`` (``kp``, ``kd``, ``ki``, ``setpoint``, ``rate``,
-        ``gravity_compensation``, ``anti_windup``); every kind takes ``limit``.  A named
-        effect; compiled (no Python per step)."""
+        """A joint actuator: an effort on the coordinate of a revolute or prismatic
+        ``joint``, equal and opposite on child and parent; ``kind`` ``"torque"``,
+        ``"motor"``, ``"pd"`` or ``"pid"`` and their keys as in ``mbdyn.elements.actuators``
+        (docs/actuators.md).  A named effect; compiled (no Python per step)."""
         return add_actuator(self, name, joint, kind, **params)
 
     def add_controller(self, name, function, rate, joints, limit=None):
-        """A controller in Python, ``function(t, q, u) -> efforts`` (one per joint of
-        ``joints``), called ``rate`` times a second; its efforts are held between calls
-        (zero-order hold) by one actuator per joint, named ``NAME_JOINT``, so that the
-        integration between samples stays compiled."""
+        """A controller in Python, ``function(t, q, u) -> efforts`` (one per joint),
+        called ``rate`` times a second; its efforts held between calls (zero-order hold)
+        by one actuator per joint, ``NAME_JOINT``: the run between samples stays compiled."""
         return add_controller(self, name, function, rate, joints, limit)
 
     def effect_names(self):

@@ -17,18 +17,19 @@ from ..kernels import forces as kf
 from .programs import program_block
 
 
-def _time_dependent(value):
-    return isinstance(value, Table) or (isinstance(value, sympy.Basic)
-                                        and bool(value.free_symbols))
+def _time_dependent(value, parameters):
+    return isinstance(value, Table) or (isinstance(value, sympy.Basic) and any(
+        s.name not in parameters for s in value.free_symbols))
 
 
-def reads_time(forces):
-    """Whether some actuator reads the time, or a state in an expression (the clock is
-    given to every actuator whose source is not a constant)."""
+def reads_time(forces, parameters):
+    """Whether some actuator may read the time: a table, or an expression of more than
+    the ``parameters`` (the clock is given to every such actuator)."""
     for el in forces:
         if el.kind == "actuator":
             p = el.params
-            if any(_time_dependent(p.get(k)) for k in ("value", "setpoint", "command")):
+            if any(_time_dependent(p.get(k), parameters)
+                   for k in ("value", "setpoint", "command")):
                 return True
     return False
 

@@ -53,7 +53,7 @@ class Model:
         self._frame_index = {nm: i for i, nm in enumerate(self.frames)}
         self.n_frames = len(bodies)
         layout.tree(self, joints)
-        layout.coordinates(self, joints, clock=reads_time(forces))
+        layout.coordinates(self, joints, clock=reads_time(forces, self.parameters))
         layout.bodies(self, bodies)
         reflect_rotors(self, forces)
         layout.reactions(self, joints)

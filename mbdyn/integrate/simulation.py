@@ -115,10 +115,8 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     plan = Plan(rhs, integrator, t0, t_end, y0, events, t_eval, progress, monitor, budget,
                 rtol, atol, max_step, dt if integrator not in ADAPTIVE else None)
     try:
-        if is_sampled(model):
-            outcome = sampled.run(plan, lambda sub: _integrate(sub, compiled_loop))
-        else:
-            outcome = _integrate(plan, compiled_loop)
+        outcome = (sampled.run(plan, lambda sub: _integrate(sub, compiled_loop))
+                   if is_sampled(model) else _integrate(plan, compiled_loop))
     finally:
         if model.has_loops:
             release_rank(model)

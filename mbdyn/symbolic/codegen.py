@@ -60,6 +60,21 @@ def _describe_value(record, key, numeric):
     return "N" + repr(np.asarray(numeric, dtype=float).round(15).tolist())
 
 
+def _describe_parameter(value):
+    """A force element's parameter as text for the signature: numbers and arrays by their
+    values, expressions by ``srepr``, laws by their expression, tables by their knots."""
+    if isinstance(value, sympy.Basic):
+        return sympy.srepr(value)
+    if hasattr(value, "expression") and hasattr(value, "function"):      # a Law
+        return "law:" + (sympy.srepr(value.expression) if value.expression is not None
+                         else f"function@{id(value.function)}")
+    if hasattr(value, "block"):                                          # a Table
+        return "table:" + repr(np.asarray(value.block()).tolist())
+    if isinstance(value, np.ndarray):
+        return repr(value.tolist())
+    return repr(value)
+
+
 def model_signature(model):
     """A hash of everything the generated code depends on (structure, expressions, numbers
     that are not parameters, parameter *names*) and of the generator itself."""
@@ -87,8 +102,14 @@ def model_signature(model):
     for ld in loads:
         parts.append(f"L{ld.name}|{ld.body}|{ld.in_body}|" + "|".join(
             _describe_value(ld, k, getattr(ld, k)) for k in ("force", "moment", "point")))
+    for el in getattr(model, "_force_elements", ()):
+        parts.append(f"F{el.name}|{el.kind}|{el.frames}|" + "|".join(
+            f"{k}={_describe_parameter(v)}" for k, v in sorted(el.params.items()))
+            + "|" + "|".join(f"{k}={_describe_parameter(v)}"
+                             for k, v in sorted(el.symbolic.items())))
     own = Path(__file__).parent
-    for name in ("codegen.py", "walk.py", "methods.py", "symbols.py", "simplify.py"):
+    for name in ("codegen.py", "walk.py", "methods.py", "symbols.py", "simplify.py",
+                 "force_elements.py"):
         parts.append(hashlib.sha256((own / name).read_bytes()).hexdigest())
     return hashlib.sha256("\n".join(parts).encode()).hexdigest()
 

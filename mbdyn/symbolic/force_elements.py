@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 import sympy
 
+from ..elements.tables import Table
 from ..errors import ModelError
 from .symbols import canonical, exact, exact_vector
 
@@ -19,7 +20,8 @@ def apply_forces(walk):
     """Every force element of the walk's model, as wrenches on its frames."""
     for el in getattr(walk.model, "_force_elements", ()):
         p = el.params
-        tabulated = [k for k in ("force_table", "damping_table") if p.get(k) is not None]
+        tabulated = [k for k in ("force_table", "damping_table", "torque_speed")
+                     if p.get(k) is not None]
         if tabulated:
             raise ModelError(f"force {el.name!r}: the symbolic layer writes linear springs "
                              "and dampers in closed form, not tabulated laws; switch it off "
@@ -71,6 +73,12 @@ def joint_spring_damper(walk, el, law):
     qj, uj, _, driven = walk.joint_values[joint.name]
     x = qj[0] - _param(walk, el, "rest")
     tau = -(_law(walk, law, x, uj[0]) if law is not None else F0 + k * x + c * uj[0])
+    joint_effort(walk, el, joint, tau)
+
+
+def joint_effort(walk, el, joint, tau):
+    """The effort ``tau`` on a revolute or prismatic joint's coordinate, on its child and,
+    opposite, its parent."""
     m = walk.by_name[joint.child]
     axis = walk._joint_geometry(joint)[0]
     # the axis in world components: joint frame J0 = child axes along the axis
@@ -176,4 +184,57 @@ def contact(walk, el, law):
 
 #: each force-element kind's wrenches
 KINDS = {"spring-damper": spring_damper, "joint-spring-damper": joint_spring_damper,
-         "bushing": bushing, "bearing": bearing, "contact": contact}
+         "bushing": bushing, "bearing": bearing, "contact": contact,
+         "joint-stop": lambda walk, el, law: joint_stop(walk, el),
+         "actuator": lambda walk, el, law: actuator(walk, el)}
+
+
+def joint_stop(walk, el):
+    """``-max(k (q - upper) + c u, 0)`` above the upper bound, ``-min(k (q - lower) + c u,
+    0)`` below the lower one, zero between (``kernels.actuation.stop_effort``)."""
+    p = el.params
+    joint = next(j for j in walk.joints if j.name == p["joint"])
+    qj, uj, _, _ = walk.joint_values[joint.name]
+    x, v = qj[0], uj[0]
+    k, c = exact(p["stiffness"]), exact(p["damping"])
+    pieces = []
+    if np.isfinite(p["upper"]):
+        up = exact(p["upper"])
+        pieces.append((sympy.Max(k * (x - up) + c * v, 0), x > up))
+    if np.isfinite(p["lower"]):
+        lo = exact(p["lower"])
+        pieces.append((sympy.Min(k * (x - lo) + c * v, 0), x < lo))
+    joint_effort(walk, el, joint, -sympy.Piecewise(*pieces, (0, True)))
+
+
+def actuator(walk, el):
+    """An actuator's effort in closed form: a torque given as a number or an expression,
+    a PD law on a setpoint of ``t``, a motor's torque-speed line; a PID, a table, a
+    controller in Python or gravity compensation are refused (their state or their data
+    are not closed forms)."""
+    p = el.params
+    kind = p["type"]
+    refuse = ("pid", "held")
+    if (kind in refuse or p.get("gravity_compensation")
+            or any(isinstance(p.get(k), Table) for k in ("value", "setpoint", "command"))):
+        raise ModelError(f"actuator {el.name!r}: the symbolic layer writes torques, PD laws "
+                         "and motors given by numbers or expressions, not PID integrals, "
+                         "sampled controllers, tables or gravity compensation; switch it "
+                         f"off to derive the rest (--effects=-{el.name})")
+    joint = next(j for j in walk.joints if j.name == p["joint"])
+    qj, uj, _, _ = walk.joint_values[joint.name]
+    value = (lambda key: canonical(sympy.sympify(p[key]), walk.sym.table))
+    if kind == "torque":
+        tau = value("value")
+    elif kind == "pd":
+        s = value("setpoint")
+        tau = (exact(p["kp"]) * (s - qj[0])
+               + exact(p["kd"]) * (sympy.diff(s, walk.sym.t) - uj[0]))
+    else:
+        gear = exact(p["gear"])
+        tau = gear * (exact(p["stall_torque"]) * (value("command")
+                                                 - gear * uj[0] / exact(p["no_load_speed"])))
+    if np.isfinite(p["limit"]):
+        lim = exact(p["limit"])
+        tau = sympy.Min(sympy.Max(tau, -lim), lim)
+    joint_effort(walk, el, joint, tau)

@@ -3,9 +3,9 @@
 coordinate), ``<limit lower upper>`` (joint stops) and ``<mimic>`` (``coupling`` loop
 joints).
 
-A stop is a one-sided spring-damper on the coordinate, a ``joint-spring-damper`` whose law
-is zero between the limits and beyond them ``k d + c v`` (``d`` the overshoot, never
-pulling the joint back into the stop).  URDF gives no stiffness, so the stop's is scaled
+A stop is a one-sided spring-damper on the coordinate (a ``joint-stop`` force element,
+compiled): zero between the limits and beyond them ``k d + c v`` (``d`` the overshoot,
+never pulling the joint back into the stop).  URDF gives no stiffness, so the stop's is scaled
 to the joint: ``k = m (2 pi STOP_FREQUENCY)^2`` and ``c = 2 STOP_DAMPING_RATIO sqrt(k m)``,
 ``m`` the mass matrix's diagonal entry of the joint at the zero configuration (the inertia
 the joint moves with the others held): the joint bounces off its stop at about
@@ -77,17 +77,6 @@ def _force(b, what, coordinate, joint, **keys):
     b.report["effects"].setdefault(what, []).append(name)
 
 
-def stop_law(lower, upper, k, c):
-    """The stop's law of ``x = q`` and ``v = q'``: zero between ``lower`` and ``upper``,
-    ``max(k (x - upper) + c v, 0)`` above, ``min(k (x - lower) + c v, 0)`` below."""
-    pieces = []
-    if math.isfinite(upper):
-        pieces.append((sympy.Max(k * (X - upper) + c * V, 0, evaluate=False), X > upper))
-    if math.isfinite(lower):
-        pieces.append((sympy.Min(k * (X - lower) + c * V, 0, evaluate=False), X < lower))
-    return sympy.Piecewise(*pieces, (0, True))
-
-
 def add_stops(b, stops):
     """One stop per ``(joint, coordinate, lower, upper)``, scaled to the joint's inertia
     at the zero configuration."""
@@ -101,7 +90,9 @@ def add_stops(b, stops):
             continue                    # no inertia: compile names the joint
         k = m * (2 * math.pi * STOP_FREQUENCY) ** 2
         damping = 2 * STOP_DAMPING_RATIO * math.sqrt(k * m)
-        _force(b, "limit", c, joint.name, law=stop_law(lower, upper, k, damping))
+        b.system.add_force(f"limit_{c}", "joint-stop", joint=joint.name, lower=lower,
+                           upper=upper, stiffness=k, damping=damping)
+        b.report["effects"].setdefault("limit", []).append(f"limit_{c}")
         b.report["stops"][f"limit_{c}"] = {"joint": joint.name, "lower": lower,
                                            "upper": upper, "stiffness": k,
                                            "damping": damping}
