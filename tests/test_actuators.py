@@ -282,3 +282,27 @@ def test_generated_equations_are_not_reused_across_force_elements():
         out.append(mb.symbolic.compiled_rhs(m).accelerations([0.1], [0.0]))
         assert np.allclose(out[-1], m.forward_dynamics([0.1], [0.0]), rtol=1e-12)
     assert out[0][0] != out[1][0]
+
+
+def test_pd_arm_holds_its_pose_and_sags_by_gravity_over_kp_without_compensation():
+    pose = np.array([0.5, -0.6, 1.2])
+    hold = mb.load_model("models/pd_arm.toml", case="hold").simulate()
+    assert np.max(np.abs(hold.q[-1] - pose)) < 1e-6
+    assert hold.stats["compiled"]
+    b = hold.energy["balance"]
+    assert np.max(np.abs(b - b[0])) < 1e-2 * np.max(np.abs(hold.energy["work"]))
+    scene = mb.load_model("models/pd_arm.toml", case="no_compensation")
+    q = scene.simulate(t_end=6.0).q[-1]
+    # at rest, kp (s - q) is the effort that holds the arm against gravity: the inverse
+    # dynamics of the same arm without its actuators, at rest at q
+    bare = scene.system.compile(effects="-drive_pan,-drive_shoulder,-drive_elbow")
+    efforts, _ = bare.inverse_dynamics(q, np.zeros(3), np.zeros(3))
+    assert np.allclose(400.0 * (pose - q), [efforts[s] for s in bare.speeds], atol=1e-6)
+    assert abs(q[1] - pose[1]) > 0.01                 # it did sag
+
+
+def test_pd_arm_tracks_a_trajectory_of_time():
+    res = mb.load_model("models/pd_arm.toml", case="track").simulate()
+    target = np.array([0.5, -0.6, 1.2]) + 0.3 * np.sin(2 * res.t)[:, None]
+    assert np.max(np.abs(res.q - target)) < 0.01
+    assert res.stats["compiled"]
