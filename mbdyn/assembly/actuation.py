@@ -107,3 +107,14 @@ def add_controller(system, name, function, rate, joints, limit=None):
                                  **({} if limit is None else {"limit": limit})))
     system._controllers[name] = Controller(name, function, rate, tuple(held))
     return name
+
+
+def attach_plant(system, model, state):
+    """A model whose PD/PID actuators feed the computed torque forward gets its plant: the
+    same system compiled without its actuators (``model._plant``), whose inverse dynamics
+    at the setpoints is that torque (``integrate.sampled``)."""
+    if not any(s.kind == "feedforward" for s in model._samplers):
+        model._plant = None
+        return
+    off = {n: False for n, el in system._forces.items() if el.kind == "actuator"}
+    model._plant = system.compile(check_inertia=False, effects={**state, **off})

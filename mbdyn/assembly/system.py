@@ -23,7 +23,7 @@ from ..elements.loads import make_load
 from ..errors import ModelError, ModelWarning, SingularMassMatrixError
 from ..limits import magnitude_problem
 from ..names import identifier_problem, label_problem
-from .actuation import add_actuator, add_controller, check_force
+from .actuation import add_actuator, add_controller, attach_plant, check_force
 from .composite import add_composite_joint
 from .loops import add_loop_joint, check_loops, loop_bodies
 from ..elements.forces import GLOBAL_EFFECTS, make_force
@@ -331,6 +331,7 @@ class System:
         if check_inertia and model.nu and not loop_joints:
             _check_inertia_of_every_dof(model)
         model.loops = {j.name: loop_bodies(self, j) for j in loop_joints}
+        attach_plant(self, model, state)
         return model
 
 

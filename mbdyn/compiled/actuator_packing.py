@@ -115,7 +115,7 @@ def pack_actuator(model, el, element, row, data, laws):
                     p.get("kd", p.get("no_load_speed", 0.0)), p.get("ki", 0.0),
                     p.get("gear", 1.0), p.get("value", 0.0) if kind == "held" else 0.0,
                     len(carried), *model.gravity,
-                    setpoint if isinstance(setpoint, float) else 0.0]
+                    setpoint if isinstance(setpoint, float) else 0.0, 0.0]
                    + [x for pair in carried for x in pair])
     row[:4] = [kf.ACTUATOR, i, int(model._parent[i]), off]
     row[8:10] = [int(model._qoff[i]), int(model._uoff[i])]
@@ -160,19 +160,27 @@ def law_block(law):
 
 @dataclass
 class Sampler:
-    """A PID's integral term, accumulated at its ``rate`` and held in the packed numbers
-    at ``slot``: ``I += ki e dt``, not past what makes the effort saturate
-    (anti-windup)."""
+    """What a run updates at ``rate`` and holds in the packed numbers at ``slot``: a PID's
+    integral term (``kind`` ``"integral"``: ``I += ki e dt``, not past what makes the
+    effort saturate) or a PD/PID's computed-torque feed-forward (``"feedforward"``: the
+    inverse dynamics at the setpoints)."""
     element: object
     slot: int
     rate: float
+    kind: str = "integral"
 
 
 def samplers(model, controllers):
-    """The PIDs' samplers (their ``held`` slot in the packed data)."""
+    """The PIDs' integral terms and the feed-forward terms (their slots in the packed
+    data)."""
     out = []
     for e, el in enumerate(model._force_elements):
-        if el.kind == "actuator" and el.params["type"] == "pid" and el.params["ki"] > 0:
-            out.append(Sampler(el, int(model._force_int[e, 3]) + ka.A_HELD,
-                               el.params["rate"]))
+        p = el.params
+        if el.kind != "actuator":
+            continue
+        off = int(model._force_int[e, 3])
+        if p["type"] == "pid" and p["ki"] > 0:
+            out.append(Sampler(el, off + ka.A_HELD, p["rate"]))
+        if p.get("feedforward"):
+            out.append(Sampler(el, off + ka.A_FEEDFORWARD, p["rate"], "feedforward"))
     return out

@@ -17,7 +17,9 @@ Actuator kinds (``System.add_actuator(name, joint, kind, ...)``):
   number, an expression of ``t`` or a table of ``t`` (its rate exact: sympy's derivative
   or the table's slope); ``I`` the integral term of a PID, accumulated at ``rate`` Hz with
   anti-windup and held between samples (``integrate.sampled``); ``gravity_compensation``
-  adds the effort that balances gravity on the bodies the joint carries;
+  adds the effort that balances gravity on the bodies the joint carries; ``feedforward``
+  adds the computed torque, the inverse dynamics of the model without its actuators at
+  the setpoints (their positions, rates and accelerations), updated at ``rate`` Hz;
 * ``held``  a value a sampled controller writes (``System.add_controller``).
 
 Every kind takes ``limit`` (saturation, default none).  A joint stop
@@ -40,9 +42,10 @@ ACTUATOR_KINDS = ("torque", "motor", "pd", "pid", "held")
 _KEYS = {"torque": ("value", "limit"),
          "motor": ("stall_torque", "no_load_speed", "torque_speed", "gear", "command",
                    "rotor_inertia", "limit"),
-         "pd": ("kp", "kd", "setpoint", "limit", "gravity_compensation"),
+         "pd": ("kp", "kd", "setpoint", "limit", "gravity_compensation", "feedforward",
+                "rate"),
          "pid": ("kp", "kd", "ki", "setpoint", "limit", "gravity_compensation", "rate",
-                 "anti_windup"),
+                 "anti_windup", "feedforward"),
          "held": ("limit", "value")}
 #: the default rate (Hz) at which a PID accumulates its integral term
 PID_RATE = 1000.0
@@ -132,7 +135,18 @@ def _controller(g, p, kind):
     if not isinstance(gc, (bool, np.bool_)):
         raise ModelError(f"{element}: gravity_compensation must be true or false, got {gc!r}")
     p["gravity_compensation"] = bool(gc)
-    if kind == "pid":
+    ff = kw.get("feedforward", False)
+    if not isinstance(ff, (bool, np.bool_)):
+        raise ModelError(f"{element}: feedforward must be true or false, got {ff!r}")
+    p["feedforward"] = bool(ff)
+    if ff and gc:
+        raise ModelError(f"{element}: feedforward (the computed torque at the setpoints) "
+                         "already balances gravity there; give feedforward or "
+                         "gravity_compensation, not both")
+    if ff and isinstance(p["setpoint"], Table):
+        raise ModelError(f"{element}: feedforward needs the setpoint's acceleration; give the "
+                         "setpoint as a number or an expression of t, not a table")
+    if kind == "pid" or ff:
         p["rate"] = g.num(kw.get("rate", PID_RATE), "rate", positive=True)
         aw = kw.get("anti_windup", True)
         if not isinstance(aw, (bool, np.bool_)):

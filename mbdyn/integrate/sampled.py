@@ -58,6 +58,8 @@ class Updates:
         self.next = {id(x): t0 for x in list(model._controllers) + list(model._samplers)}
         self.setpoints = {id(s): _function_of_t(s.element.params["setpoint"])
                           for s in model._samplers}
+        self.desired = _desired_motions(model) if any(
+            s.kind == "feedforward" for s in model._samplers) else None
         for s in model._samplers:            # a run starts with no integral
             data[s.slot] = 0.0
         for _, slots in self.held:
@@ -78,10 +80,28 @@ class Updates:
                 for k, val in zip(slots, efforts):
                     if k >= 0:
                         model._force_data[k] = val
+        torques = None
         for s in model._samplers:
             if t >= self.next[id(s)] - tol:
                 self.next[id(s)] += 1.0 / s.rate
-                self._integrate(s, t, q, u)
+                if s.kind == "integral":
+                    self._integrate(s, t, q, u)
+                    continue
+                if torques is None:
+                    torques = self._computed_torque(t, q, u)
+                j = model._joint[s.element.params["joint"]]
+                model._force_data[s.slot] = torques[j.speeds[0]]
+
+    def _computed_torque(self, t, q, u):
+        """The plant's inverse dynamics at the setpoints: the PD/PID joints at their
+        setpoints' positions, rates and accelerations, the others where they are, at zero
+        acceleration."""
+        model = self.model
+        qd, ud, udd = q.copy(), u.copy(), np.zeros(model.nu)
+        for kq, ku, (s, sd, sdd) in self.desired:
+            qd[kq], ud[ku], udd[ku] = s(t), sd(t), sdd(t)
+        efforts, _ = model._plant.inverse_dynamics(qd, ud, udd, t)
+        return efforts
 
     def _integrate(self, s, t, q, u):
         """One sample of a PID's integral: ``I += ki e / rate`` (the error at the
@@ -97,6 +117,27 @@ class Updates:
                 return                      # saturated: integrating would wind up
             grown = min(max(grown, -p["limit"]), p["limit"])
         data[s.slot] = grown
+
+
+def _desired_motions(model):
+    """``[(index of the joint's coordinate, of its speed, (s, s', s''))]`` of every
+    PD/PID actuator: its setpoint and the setpoint's derivatives, functions of ``t``."""
+    out = []
+    t = sympy.Symbol("t")
+    for el in model._force_elements:
+        p = el.params
+        if el.kind != "actuator" or p["type"] not in ("pd", "pid"):
+            continue
+        j = model._joint[p["joint"]]
+        expr = p["setpoint"]
+        expr = (sympy.Float(expr) if not isinstance(expr, sympy.Basic) else
+                expr.subs({s: model.parameters[s.name] for s in expr.free_symbols
+                           if s.name in model.parameters}))
+        expr = expr.subs({s: t for s in expr.free_symbols if s.name == "t"})
+        parts = [sympy.lambdify(t, e, "math") for e in (expr, expr.diff(t), expr.diff(t, 2))]
+        out.append((model.coordinate_index(j.coordinates[0]), model.speed_index(j.speeds[0]),
+                    tuple(lambda x, f=f: float(f(x)) for f in parts)))
+    return out
 
 
 def _function_of_t(value):

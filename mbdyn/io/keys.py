@@ -57,7 +57,7 @@ ACTUATOR_KINDS = ("torque", "motor", "pd", "pid")
 ACTUATOR_KEYS = {"name": "name", "joint": "name", "kind": ("choice", ACTUATOR_KINDS),
                  "value": "signal", "setpoint": "signal", "command": "signal",
                  "kp": "expr", "kd": "expr", "ki": "expr", "limit": "expr", "rate": "expr",
-                 "anti_windup": "bool", "gravity_compensation": "bool",
+                 "anti_windup": "bool", "gravity_compensation": "bool", "feedforward": "bool",
                  "stall_torque": "expr", "no_load_speed": "expr", "torque_speed": "table",
                  "gear": "expr", "rotor_inertia": "expr",
                  "interpolation": ("choice", ("pchip", "linear"))}

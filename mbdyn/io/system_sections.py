@@ -288,7 +288,7 @@ def add_actuators(b):
         for key, value in act.items():
             at = path + (key,)
             if key in ("name", "joint", "kind", "interpolation", "gravity_compensation",
-                       "anti_windup"):
+                       "anti_windup", "feedforward"):
                 if key not in ("name", "joint", "kind"):
                     kw[key] = value
             elif key in ACTUATOR_SIGNALS and isinstance(value, list):

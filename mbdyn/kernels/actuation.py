@@ -16,8 +16,10 @@ n_vars, ops (2 n_ops), consts, variable codes]``.  A variable code ``k >= 0`` re
 
 Actuator numbers (``force_data[off:]``, written by ``compiled.actuator_packing``):
 ``[type, prismatic, clock slot (-1: none), limit, a, b, ki, gear, held, n_carried,
-gravity (3), setpoint, (frame, mass) of each body the joint carries]``; ``a, b`` are
-``kp, kd`` (PD, PID) or the stall torque and no-load speed (motor).
+gravity (3), setpoint, feed-forward, (frame, mass) of each body the joint carries]``;
+``a, b`` are ``kp, kd`` (PD, PID) or the stall torque and no-load speed (motor); ``held``
+(a PID's integral term, a sampled controller's effort) and ``feed-forward`` (the computed
+torque) are written between compiled stretches (``integrate.sampled``).
 """
 from numba import njit
 
@@ -32,7 +34,7 @@ CONSTANT, PROGRAM = 0, 4                  # source modes besides the tables' LIN
 X_VAR, V_VAR = -(1 << 40), -(1 << 40) - 1
 #: where each number sits in an actuator's block
 (A_TYPE, A_PRISMATIC, A_CLOCK, A_LIMIT, A_GAIN, A_RATE, A_KI, A_GEAR, A_HELD, A_CARRIED,
- A_GRAVITY, A_SETPOINT, A_BODIES) = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 13, 14
+ A_GRAVITY, A_SETPOINT, A_FEEDFORWARD, A_BODIES) = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 13, 14, 15
 #: floats of scratch a program needs: its variables (at most ``MAX_VARS``) and the stack
 MAX_VARS = 32
 PROGRAM_WORK = MAX_VARS + STACK
@@ -138,7 +140,7 @@ def actuator_effort(data, off, row, q, u, qfull, ufull, i, axis, com, R, r, e, w
             if row[7] == PROGRAM:
                 rate = program_value(data, row[6], t, q, u, qfull, ufull, work)
         tau = (data[off + A_GAIN] * (setpoint - q) + data[off + A_RATE] * (rate - u)
-               + data[off + A_HELD])
+               + data[off + A_HELD] + data[off + A_FEEDFORWARD])
         if data[off + A_CARRIED] > 0.0:
             tau += gravity_effort(data, off, i, axis, com, R, r, e, work[0:3], work[3:6])
     limit = data[off + A_LIMIT]
