@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ModelError
-from .sections import Section
+from .invariants import MassPoints
 from .shapes import GAUSS_POINTS, GAUSS_WEIGHTS, element_rows
 
 COMPONENTS = ("u", "v", "w", "rx", "ry", "rz")
@@ -198,6 +198,34 @@ class Beam:
         Kg = (np.einsum("eg,eg,egi,egj->eij", wl, N, dT[:, :, 1], dT[:, :, 1])
               + np.einsum("eg,eg,egi,egj->eij", wl, N, dT[:, :, 2], dT[:, :, 2]))
         return self._assemble(Kg)
+
+    def mass_points(self, modes):
+        """The beam as :class:`~mbdyn.flexible.invariants.MassPoints` for the mode shapes
+        ``modes`` (n_dofs, n): each element's Gauss points (weights times ``rho A`` and
+        the rotary inertia), so that the invariants are the consistent model's integrals,
+        exact for its polynomials; then the attachments on their nodes."""
+        modes = np.asarray(modes, dtype=float)
+        xg, wl, T, R, _, _ = self.element_points()
+        rhoA, rot = self._section_inertia()
+        Phi_e = np.stack([modes[6 * e:6 * e + 12] for e in range(self.n_elements)])
+        n_pts = xg.size
+        position = np.zeros((n_pts, 3))
+        position[:, 0] = xg.ravel()
+        mass = (wl * rhoA[:, None]).ravel()
+        inertia = np.zeros((n_pts, 3, 3))
+        inertia[:, [0, 1, 2], [0, 1, 2]] = (wl[:, :, None] * rot[:, None, :]).reshape(-1, 3)
+        trans = np.einsum("egij,ejn->egin", T, Phi_e).reshape(n_pts, 3, -1)
+        rotat = np.einsum("egij,ejn->egin", R, Phi_e).reshape(n_pts, 3, -1)
+        if self.attachments:
+            a = self.attachments
+            node_modes = modes.reshape(self.n_nodes, 6, -1)[[t.node for t in a]]
+            position = np.vstack([position, self.nodes[[t.node for t in a]]])
+            mass = np.concatenate([mass, [t.mass for t in a]])
+            inertia = np.concatenate([inertia, [np.diag([t.polar, t.diametral, t.diametral])
+                                                for t in a]])
+            trans = np.concatenate([trans, node_modes[:, :3]])
+            rotat = np.concatenate([rotat, node_modes[:, 3:]])
+        return MassPoints(mass, position, inertia, trans, rotat)
 
     def outboard(self, x):
         """The mass beyond each position ``x`` and its first moment about the origin:
