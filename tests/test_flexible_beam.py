@@ -294,6 +294,10 @@ def test_named_nodes_snap_to_the_nearest():
                         "nodes": {"mid": 0.43, "half": 0.45}})
     assert b.node("mid") == 4 and b.node("half") == 4 and b.node("tip") == 10
     assert b.node(0.96) == 10 and b.node("root") == 0
+    thirds = beam_from_spec({"length": 1.0, "elements": 3, "circle": 0.02, **STEEL})
+    assert thirds.node(0.5) == 1                  # halfway (to rounding): nearer the root
+    with pytest.raises(ModelError, match="off the beam"):
+        thirds.node(1.5)
     np.testing.assert_allclose(b.nodes[:, 0], np.linspace(0, 1, 11))
 
 

@@ -29,6 +29,13 @@ from .shapes import GAUSS_POINTS, GAUSS_WEIGHTS, element_rows
 COMPONENTS = ("u", "v", "w", "rx", "ry", "rz")
 
 
+def nearest_node(x, where):
+    """The index of the node of ``x`` nearest to ``where``; of two as near (to 1e-9 of
+    the beam's length), the one nearer the root."""
+    gap = np.abs(np.asarray(x) - where)
+    return int(np.flatnonzero(gap <= gap.min() + 1e-9 * max(abs(x[-1]), 1e-300))[0])
+
+
 @dataclass(frozen=True)
 class Attachment:
     """A rigid body on a node: ``mass`` (kg), ``polar`` inertia about x and ``diametral``
@@ -90,7 +97,10 @@ class Beam:
             if not 0 <= which < self.n_nodes:
                 raise ModelError(f"node {which} is not one of 0 .. {self.n_nodes - 1}")
             return int(which)
-        return int(np.argmin(np.abs(self.x - float(which))))
+        where = float(which)
+        if not -1e-9 * self.length <= where <= self.length * (1 + 1e-9):
+            raise ModelError(f"position {where:g} is off the beam (0 .. {self.length:g})")
+        return nearest_node(self.x, where)
 
     def dofs(self, nodes=None, components=COMPONENTS):
         """Indices of the DoFs ``components`` (names from u, v, w, rx, ry, rz) of

@@ -58,6 +58,8 @@ def whirl(M, G, K, spin, fixed=(), *, y_dof=None, z_dof=None):
     direction = np.zeros(len(lam), dtype=int)
     if y_dof is not None and z_dof is not None:
         where = {d: i for i, d in enumerate(free)}
+        if y_dof not in where or z_dof not in where:
+            raise ModelError(f"y_dof {y_dof} and z_dof {z_dof} must be free DoFs (not held)")
         V, W = vec[where[y_dof]], vec[where[z_dof]]
         sense = np.imag(V * np.conj(W)) * np.sign(spin if spin else 1.0)
         scale = np.abs(V) ** 2 + np.abs(W) ** 2

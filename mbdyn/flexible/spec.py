@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import numbers
 import warnings
 
 import numpy as np
@@ -34,7 +35,7 @@ import numpy as np
 from ..errors import ModelError, ModelWarning
 from ..limits import MAX_BEAM_ELEMENTS
 from ..names import identifier_problem
-from .beam import Attachment, Beam
+from .beam import Attachment, Beam, nearest_node
 from .sections import KINDS, make_section
 
 THEORIES = ("timoshenko", "euler-bernoulli")
@@ -58,7 +59,7 @@ def _number(table, name, key, *, default=None, low=None, strict=True):
             raise ModelError(f"{key}.{name}: missing; give a number")
         return default
     value = table[name]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) \
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) \
             or not math.isfinite(value):
         raise ModelError(f"{key}.{name}: must be a finite number, got {value!r}")
     if low is not None and (value <= low if strict else value < low):
@@ -73,7 +74,7 @@ def _segment(table, key):
     _unknown(table, SEGMENT_KEYS, key)
     length = _number(table, "length", key, low=0.0)
     elements = table.get("elements", 1)
-    if isinstance(elements, bool) or not isinstance(elements, int) or elements < 1:
+    if isinstance(elements, bool) or not isinstance(elements, numbers.Integral) or elements < 1:
         raise ModelError(f"{key}.elements: must be a whole number >= 1, got {elements!r}")
     kinds = [k for k in KINDS if k in table]
     if len(kinds) != 1:
@@ -111,7 +112,7 @@ def _named_nodes(table, x, key):
         where = _number(table, name, f"{key}.nodes", low=None)
         if not -1e-9 * x[-1] <= where <= x[-1] * (1 + 1e-9):
             raise ModelError(f"{key}.nodes.{name}: {where:g} is off the beam (0 .. {x[-1]:g})")
-        names[name] = int(np.argmin(np.abs(x - where)))
+        names[name] = nearest_node(x, where)
     return names
 
 
@@ -130,7 +131,7 @@ def _attachment(table, x, names, key):
         where = _number(table, "at", key)
         if not -1e-9 * x[-1] <= where <= x[-1] * (1 + 1e-9):
             raise ModelError(f"{key}.at: {where:g} is off the beam (0 .. {x[-1]:g})")
-        node = int(np.argmin(np.abs(x - where)))
+        node = nearest_node(x, where)
     m = _number(table, "mass", key, default=0.0, low=0.0, strict=False)
     polar = _number(table, "polar", key, default=0.0, low=0.0, strict=False)
     diam = _number(table, "diametral", key, default=0.0, low=0.0, strict=False)
@@ -162,6 +163,7 @@ def beam_from_spec(spec, key="flexible.beam"):
                          "model rarely needs more than a few dozen")
     x, E, G, rho, sections = [0.0], [], [], [], []
     for length, n, section, e, r, nu in segments:
+        n = int(n)
         x.extend(x[-1] + length * np.arange(1, n + 1) / n)
         E += [e] * n
         G += [e / (2.0 * (1.0 + nu))] * n
