@@ -105,3 +105,11 @@ MAX_WALL_TIME = None
 #: handshake, a finished member's result, the scheduler's answer to a check while members
 #: run (``sweep(scheduler_timeout=...)``, ``mbdyn sweep --scheduler-timeout``)
 SCHEDULER_TIMEOUT = 30.0
+
+# -- flexible bodies (mbdyn/flexible; docs/flexible.md)
+#: elements of one beam model (its eigenproblems are dense: 1,000 elements are 6,006 DoFs,
+#: some 20 s); a reduced body rarely needs more than a few dozen
+MAX_BEAM_ELEMENTS = 1000
+#: modal coordinates of one reduced body, and nodes of user-supplied reduced data
+MAX_MODES = 500
+MAX_FLEXIBLE_NODES = 100_000

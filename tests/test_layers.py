@@ -17,6 +17,9 @@ LAYERS = [
     # the package itself imports its public names on first use only (PEP 562)
     ("ground", ["mbdyn.errors", "mbdyn.limits", "mbdyn.names", "mbdyn.escape", "mbdyn.files"]),
     ("kernels", ["mbdyn.kernels"]),
+    # flexible bodies' beam model, reductions and inertia invariants (numpy, scipy only);
+    # the element records and the packing at compile build on them
+    ("flexible", ["mbdyn.flexible"]),
     ("elements", ["mbdyn.elements"]),
     ("algorithms", ["mbdyn.algorithms"]),
     ("compiled", ["mbdyn.compiled"]),
