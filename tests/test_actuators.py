@@ -334,3 +334,32 @@ def test_computed_torque_feedforward_tracks_with_a_tiny_error():
     with pytest.raises(ModelError, match="feedforward or gravity_compensation, not both"):
         wheel().add_actuator("x", "th", "pd", kp=1.0, feedforward=True,
                              gravity_compensation=True)
+
+
+def test_gravity_compensated_pd_equals_the_same_law_as_python_loads():
+    # an independent route: the PD and g(q) written as Python-function loads (+tau on the
+    # child, -tau on the parent), g from the inverse dynamics of the bare arm at rest
+    scene = mb.load_model("models/pd_arm.toml")
+    system = scene.system
+    bare = system.compile(effects="-drive_pan,-drive_shoulder,-drive_elbow")
+    pose = np.array([0.5, -0.6, 1.2])
+    s = mb.System("loads", gravity=(0, 0, -9.81))
+    for b in ("base", "upper_arm", "forearm"):
+        rec = system.bodies[b]
+        s.add_body(b, mass=rec.mass, com=rec.com, inertia=rec.inertia)
+    for k, (name, j) in enumerate(system.joints.items()):
+        s.add_joint(name, "revolute", parent=j.parent, child=j.child, axis=j.axis,
+                    position=j.position)
+
+        def tau(t, q, u, k=k):
+            g = bare.inverse_dynamics(q, np.zeros(3), np.zeros(3))[0]
+            return 400.0 * (pose[k] - q[k]) - 40.0 * u[k] + g[bare.speeds[k]]
+        a = np.asarray(j.axis, float)      # the same components in parent and child axes
+        s.add_load(f"{name}_c", j.child, frame="body", moment=lambda t, q, u, f=tau, a=a:
+                   f(t, q, u) * a)
+        if j.parent != "ground":
+            s.add_load(f"{name}_p", j.parent, frame="body", moment=lambda t, q, u, f=tau,
+                       a=a: -f(t, q, u) * a)
+    r1 = scene.simulate(t_end=0.5)
+    r2 = mb.simulate(s.compile(), 0.5, q0=scene.q0, u0=scene.u0, t_eval=r1.t)
+    assert np.max(np.abs(r1.q - r2.q)) < 1e-9
