@@ -363,3 +363,12 @@ def test_gravity_compensated_pd_equals_the_same_law_as_python_loads():
     r1 = scene.simulate(t_end=0.5)
     r2 = mb.simulate(s.compile(), 0.5, q0=scene.q0, u0=scene.u0, t_eval=r1.t)
     assert np.max(np.abs(r1.q - r2.q)) < 1e-9
+
+
+def test_a_controller_sampled_too_slowly_is_named_as_the_suspect():
+    # a digital PD whose derivative gain over the inertia exceeds 2 / rate is unstable
+    s = wheel(0.1)
+    s.add_controller("slow", lambda t, q, u: [-100.0 * q[0] - 30.0 * u[0]], rate=20.0,
+                     joints=["th"])
+    with pytest.raises(mb.SimulationError, match="sampled too slowly.*raise its rate"):
+        mb.simulate(s.compile(), 20.0, q0={"th": 0.1}, max_steps=20000)

@@ -196,6 +196,11 @@ def run(plan, integrate):
             info[key] = info.get(key, 0) + val if key in _COUNTERS else val
         y = np.array(out.ys[-1], float)
         stopped = out.ts[-1] < t_next - 1e-12 * max(1.0, abs(t_next))
+        if "failure" in out.info:
+            info["failure"] = (f"{out.info['failure']} -- in the stretch {tk:.6g} .. "
+                               f"{t_next:.6g} s between two sampling instants of the run "
+                               f"to {plan.t_end:.6g} s; a controller sampled too slowly for "
+                               "its gains makes the loop unstable: raise its rate")
         if "failure" in out.info or stopped:
             break
     return Outcome(np.concatenate(ts), np.vstack(ys), found, info)
