@@ -26,12 +26,15 @@ METHODS = ("jourdain", "articulated", "newton-euler", "newton-euler-dense")
 ARTICULATED_FROM = 6
 
 
-def forward_dynamics(model, q, u, t=0.0, method="jourdain"):
+def forward_dynamics(model, q, u, t=0.0, method="auto"):
     """Speed rates ``u'``: from ``M(q) u' = f(q, u, t)`` (``method="jourdain"``), by the
     articulated-body algorithm (``"articulated"``), or from the Newton-Euler system with
     reactions, eliminated in tree order (``"newton-euler"``) or assembled dense and
     solved by LU (``"newton-euler-dense"``).  All four solve the same equations;
-    ``docs/performance.md`` says which is fastest at which size."""
+    ``"auto"`` (the default) takes the fastest at the model's size (``formulation``,
+    docs/performance.md)."""
+    if method == "auto":
+        method = model._auto_route
     if model._con is not None and method in ("jourdain", "articulated"):
         return model._constrained_accelerations(q, u, t)     # closed loops: G u' = gamma
     if model._con is not None and method in ("newton-euler", "newton-euler-dense"):
@@ -76,10 +79,12 @@ def formulation(model, method="auto"):
     return method
 
 
-def state_derivative(model, t, y, method="jourdain"):
+def state_derivative(model, t, y, method="auto"):
     """``[q', u']`` for the state ``y = [q, u]`` in one compiled call: ``q' = N(q) u``
     (``coordinate_rates``) and ``u'`` as ``forward_dynamics`` gives it (``method``:
-    ``"jourdain"`` or ``"articulated"``).  Returns a new array."""
+    ``"auto"``, ``"jourdain"`` or ``"articulated"``).  Returns a new array."""
+    if method == "auto":
+        method = model._auto_route
     try:
         y = np.asarray(y, dtype=float)
     except (TypeError, ValueError):

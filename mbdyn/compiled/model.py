@@ -86,6 +86,8 @@ class Model:
         self._samplers = samplers(self, controllers)
         layout.argument_groups(self)
         layout.constraints(self, loop_joints)
+        #: the route ``method="auto"`` takes (``forward_dynamics.formulation``)
+        self._auto_route = forward.formulation(self, "auto")
 
     def __repr__(self):
         return (f"<Model {self.name!r}: {self.n_frames} frames, {len(self.joints)} joints, "
