@@ -58,6 +58,26 @@ def reactions(model, q, u, t=0.0, method="auto", frame="world"):
     return out
 
 
+def reaction_array(model, q, u, t=0.0, frame="world"):
+    """The reactions as one array, a row per joint in ``Model.joints`` order: ``[Fx, Fy,
+    Fz, Mx, My, Mz]``, what the parent exerts on the child about the joint origin (world
+    components, or the child's with ``frame="child"``) -- ``reactions`` without its
+    dictionaries, by the Newton-Euler equations in tree order (one compiled call; the
+    loop joints' multipliers for a closed mechanism)."""
+    if frame not in ("world", "child"):
+        raise ModelError(f"unknown frame {frame!r} for reactions; use 'world' or 'child'")
+    if model._con is not None:
+        out = reactions(model, q, u, t, frame=frame)
+        return np.array([np.concatenate(out[name]) for name in model.joints])
+    model._newton_euler(q, u, t)                  # u' and the joint wrenches, checked
+    w = model._W.copy()
+    if frame == "child":
+        R = model._R
+        w[:, :3] = np.einsum("nji,nj->ni", R, w[:, :3])
+        w[:, 3:] = np.einsum("nji,nj->ni", R, w[:, 3:])
+    return w
+
+
 def inverse_dynamics(model, q, u, u_dot, t=0.0, frame="world"):
     """The efforts and reactions that make the motion ``(q, u, u')``: returns
     ``(efforts, reactions)`` -- ``efforts`` ``{speed name: generalized force}`` the

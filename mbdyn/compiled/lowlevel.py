@@ -70,6 +70,23 @@ def _articulated_state(fb, ib, y, ydot):
     return _state(kp.state_derivative_articulated_packed, fb, ib, y, ydot)
 
 
+def _tree_reactions(fb, ib, q, u, out):
+    """The joint wrenches ``out`` (frames x 6: force, moment; world components, about
+    each child's origin) and ``u'`` by the Newton-Euler equations in tree order."""
+    n = ib[0]
+    if q.shape[0] != ib[7] or u.shape[0] != ib[1] or out.shape[0] != n or out.shape[1] != 6:
+        return WRONG_SIZE
+    status = kp.newton_euler_tree_packed(fb, ib, ib, q, u)
+    wrench = c_view(fb, ib[kp.WRENCH], (n, 6))
+    for i in range(n):
+        for k in range(6):
+            out[i, k] = wrench[i, k]
+    return status
+
+
+#: the signature of the reactions' entry point
+REACTIONS_SIGNATURE = ("int64(float64[::1], int64[::1], float64[::1], float64[::1], "
+                       "float64[:, ::1])")
 #: per-call formulations of the low-level entry: (forward dynamics, state derivative)
 ROUTES = {"jourdain": (_jourdain_forward, _jourdain_state),
           "articulated": (_articulated_forward, _articulated_state)}
@@ -104,6 +121,7 @@ class LowLevel:
         self._inputs = model._python_inputs
         self._nq, self._nu = model.nq, model.nu
         self._ydot = np.empty(model.nq + model.nu)
+        self._wrenches = np.empty((model.n_frames, 6))
         self.forward_dynamics = self._bind_forward_dynamics()
 
     def _bind_forward_dynamics(self):
@@ -149,6 +167,33 @@ class LowLevel:
                 self._refuse(y=y, out=ydot)
             self.model.state_derivative(t, y, self.method)   # raises the precise error
         return ydot
+
+    def reactions(self, q, u, t=0.0, out=None):
+        """The joint wrenches, one row per joint in ``Model.joints`` order: the force and
+        the moment the parent exerts on the child about the joint origin, world
+        components (``Model.reaction_array``), by the Newton-Euler equations in tree
+        order (whatever the entry's route); a workspace array unless ``out`` is given."""
+        model = self.model
+        if model._con is not None:
+            raise ModelError(f"model {model.name!r} has closed loops: use "
+                             "model.reaction_array(q, u, t)")
+        if self._inputs:
+            self._refuse(q=q, u=u)
+            model._fill_inputs(q, u, t)
+        if out is None:
+            out = self._wrenches
+        try:
+            status = _entry(_tree_reactions, REACTIONS_SIGNATURE)(self._fb, self._ib, q, u,
+                                                                   out)
+        except TypeError:
+            status = WRONG_SIZE
+        if status != -1:
+            if status == WRONG_SIZE:
+                self._refuse(q=q, u=u)
+                raise ModelError(f"lowlevel: out must be a contiguous, writable float64 "
+                                 f"array of shape ({model.n_frames}, 6)")
+            model.reaction_array(q, u, t)          # raises the precise error
+        return out
 
     def _refuse(self, **arrays):
         """Raise, naming the first of ``arrays`` that is not a C-contiguous float64 array of

@@ -189,6 +189,7 @@ class Model:
     state_derivative = forward.state_derivative
     newton_euler = ne.newton_euler
     reactions = joint_reactions.reactions
+    reaction_array = joint_reactions.reaction_array
     inverse_dynamics = joint_reactions.inverse_dynamics
     inverse_dynamics_along = joint_reactions.inverse_dynamics_along
     drive_efforts = joint_reactions.drive_efforts
