@@ -86,13 +86,18 @@ def robot_rows(name, floating, budget, repeats):
     ud = rng.normal(size=model.nu)
     low = model.lowlevel("auto")
     out = np.empty(model.nu)
+    wrenches = np.empty((model.n_frames, 6))
     cases = {
         "fd": (model.forward_dynamics, (q, u), {}, 1),
         "fd_low": (low.forward_dynamics, (q, u, 0.0, out), {}, 1),
         "id": (model.inverse_dynamics, (q, u, ud), {}, 1),
         "M": (model.mass_matrix, (q,), {}, 1),
+        "react": (model.reaction_array, (q, u), {}, 1),
+        "react_low": (low.reactions, (q, u, 0.0, wrenches), {}, 1),
+        "react_dict": (model.reactions, (q, u), {}, 1),
     }
-    ratios = [("fd", "aba"), ("fd_low", "aba"), ("id", "rnea"), ("M", "crba")]
+    ratios = [("fd", "aba"), ("fd_low", "aba"), ("id", "rnea"), ("M", "crba"),
+              ("react", "aba_rnea"), ("react_low", "aba_rnea"), ("react_dict", "aba_rnea")]
     if not floating:                         # the free flyer's speeds differ: not mapped
         qp, vp = pin_state(pmodel, model, q, u)
         tau = np.zeros(pmodel.nv)
@@ -109,6 +114,10 @@ def robot_rows(name, floating, budget, repeats):
         "aba": (pin.aba, (pmodel, pdata, qp, vp, tau), {}, 1),
         "rnea": (pin.rnea, (pmodel, pdata, qp, vp, ap), {}, 1),
         "crba": (pin.crba, (pmodel, pdata, qp), {}, 1),
+        # what reactions cost Pinocchio: the accelerations (aba), then the joint forces
+        # of that motion (rnea, which leaves them in data.f)
+        "aba_rnea": (lambda: pin.rnea(pmodel, pdata, qp, vp, pin.aba(pmodel, pdata, qp, vp,
+                                                                      tau)), (), {}, 1),
     })
     stats, ratio = fdb.measure(cases, budget, repeats, ratios)
 
@@ -129,8 +138,10 @@ def main():
     print("| robot | nu | fd (ordinary) | fd (low-level) | aba | id | rnea | M | crba | "
           "load mbdyn / Pinocchio (ms) |")
     print("|---|---|---|---|---|---|---|---|---|---|")
+    reaction_rows = []
     for name, floating in ROBOTS:
         nu, st, ratio, load = robot_rows(name, floating, budget, repeats)
+        reaction_rows.append((name, floating, nu, st, ratio))
 
         def us(key, against=None):
             text = f"{st[key]['median_us']:.2f}"
@@ -139,6 +150,18 @@ def main():
               f"{us('fd_low', 'aba')} | {us('aba')} | {us('id', 'rnea')} | {us('rnea')} | "
               f"{us('M', 'crba')} | {us('crba')} | {load[0] * 1e3:.1f} / "
               f"{load[1] * 1e3:.2f} |", flush=True)
+    print("\nReactions (issue 25, item 8): every joint's wrench, against Pinocchio's aba + "
+          "rnea\n")
+    print("| robot | nu | reaction_array | lowlevel().reactions | reactions (dicts) | "
+          "aba + rnea |")
+    print("|---|---|---|---|---|---|")
+    for name, floating, nu, st, ratio in reaction_rows:
+        def us2(key, against=None):
+            text = f"{st[key]['median_us']:.2f}"
+            return text + (f" ({ratio[(key, against)]['median']:.2f}x)" if against else "")
+        print(f"| {name}{' floating' if floating else ''} | {nu} | "
+              f"{us2('react', 'aba_rnea')} | {us2('react_low', 'aba_rnea')} | "
+              f"{us2('react_dict', 'aba_rnea')} | {us2('aba_rnea')} |")
 
 
 if __name__ == "__main__":

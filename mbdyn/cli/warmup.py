@@ -41,7 +41,8 @@ ROUTES = (
     ("articulated", "6 or more speeds: the articulated-body route, a spherical joint "
      "(DOP853, semi-implicit Euler, RK4)", True,
      _runs(["chain"], ["DOP853", "semi-implicit-euler", "rk4"])),
-    ("force elements", "springs, dampers, tables, bushing, bearing, contact, a drive; on "
+    ("force elements", "springs, dampers, tables, bushing, bearing, contact, a stop, a "
+     "compiled law, a PD actuator, a drive; on "
      "both routes (DOP853, semi-implicit Euler, RK4)", True,
      _runs(["forces"], ["DOP853", "semi-implicit-euler", "rk4"])
      + _runs(["chain_forces"], ["DOP853", "semi-implicit-euler"])),

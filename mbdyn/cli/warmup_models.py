@@ -86,8 +86,8 @@ reactions = true
 energy = true
 """
 
-#: every kind of force element, tables and a drive (a block on springs, a rotor on a
-#: bearing, a ball on the floor)
+#: every kind of force element, tables, a drive, a compiled law and an actuator reading
+#: the clock (a block on springs, a rotor on a bearing, a ball on the floor)
 FORCES = """
 [model]
 name = "warm-up forces"
@@ -194,6 +194,28 @@ radius = 0.02
 stiffness = 1e5
 restitution = 0.8
 friction = 0.3
+
+[[forces]]
+name = "stop"
+kind = "joint-stop"
+joint = "z"
+lower = -1
+upper = 1
+stiffness = 1e4
+
+[[forces]]
+name = "friction"
+kind = "joint-spring-damper"
+joint = "x"
+law = "0.1*tanh(v/0.01)"
+
+[[actuators]]
+name = "push"
+joint = "x"
+kind = "pd"
+kp = 10
+kd = 1
+setpoint = "0.01*sin(t)"
 
 [simulation]
 t_end = 0.02
