@@ -23,6 +23,7 @@ from ..elements.loads import make_load
 from ..errors import ModelError, ModelWarning, SingularMassMatrixError
 from ..limits import magnitude_problem
 from ..names import identifier_problem, label_problem
+from . import contacts
 from .composite import add_composite_joint
 from .loops import add_loop_joint, check_loops, loop_bodies
 from ..elements.forces import GLOBAL_EFFECTS, make_force
@@ -77,6 +78,7 @@ class System:
         self._state_names = set()     # the joints' coordinates and speeds
         self._loads = {}
         self._forces = {}
+        self._shapes = {}             # contact shapes (assembly.contacts)
 
     # ------------------------------------------------------------------ building
     def symbols(self, names):
@@ -257,6 +259,9 @@ class System:
         self._forces[name] = el
         return name
 
+    add_shape = contacts.add_shape
+    add_contact = contacts.add_contact
+
     def effect_names(self):
         """Every effect of the system: ``gravity``, ``gyroscopic``, loads, force elements."""
         return GLOBAL_EFFECTS + tuple(self._loads) + tuple(self._forces)
@@ -277,6 +282,10 @@ class System:
     @property
     def forces(self):
         return dict(self._forces)
+
+    @property
+    def shapes(self):
+        return dict(self._shapes)
 
     # ------------------------------------------------------------------ compile
     def topological_frames(self):

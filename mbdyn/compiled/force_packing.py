@@ -10,6 +10,7 @@ import numpy as np
 from ..errors import ModelError
 from ..elements.forces import BEARING_COEFFICIENTS, Table
 from ..kernels import forces as kf
+from .contact_packing import pack_contact
 
 
 def _frame(model, name, element):
@@ -157,7 +158,8 @@ def _contact(model, el, element, row, data, laws):
 
 #: each force-element kind's packer: its row of integers and its numbers in the data
 _PACKERS = {"spring-damper": _spring_damper, "joint-spring-damper": _joint_spring_damper,
-            "bushing": _bushing, "bearing": _bearing, "contact": _contact}
+            "bushing": _bushing, "bearing": _bearing, "contact": _contact,
+            "shape-contact": pack_contact}
 
 
 def warn_outside_tables(model, t, u):

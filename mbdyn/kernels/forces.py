@@ -24,6 +24,7 @@ import math
 
 from numba import njit
 
+from .contact import CONTACT_SHAPES, shape_contacts
 from .linalg3 import cross_to, mat_t_vec, mat_vec
 from .views import UNCOUNTED
 
@@ -277,6 +278,8 @@ def force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r,
                 for q in range(3):
                     P += f[q] * (va[q] - vb[q])
                 acc[1] += P
+        elif kind == CONTACT_SHAPES:       # between shapes: kernels/contact.py
+            shape_contacts(off, force_data, R, r, w, v, com, F, N, acc, want, work[FORCE_WORK:])
         else:
             _contact(kind, ia, off, force_data, R, r, w, v, com, F, N, acc, want,
                      pa, va, d, f, lever, t, e1, zero)

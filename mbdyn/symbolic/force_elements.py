@@ -174,6 +174,13 @@ def contact(walk, el, law):
     walk._add_wrench(el.name, a, f, Z3, own)
 
 
+def shape_contact(walk, el, law):
+    raise ModelError(f"contact {el.name!r}: contact between shapes (a broad phase, nearest "
+                     "points, cam profiles) has no closed form in the symbolic layer; switch "
+                     f"it off to derive the rest (--effects=-{el.name})")
+
+
 #: each force-element kind's wrenches
 KINDS = {"spring-damper": spring_damper, "joint-spring-damper": joint_spring_damper,
-         "bushing": bushing, "bearing": bearing, "contact": contact}
+         "bushing": bushing, "bearing": bearing, "contact": contact,
+         "shape-contact": shape_contact}
