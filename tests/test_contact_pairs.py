@@ -217,6 +217,17 @@ def test_the_follower_leaves_the_cam_above_the_critical_speed():
     assert follower_release(1e11, omega) == pytest.approx(rigid, rel=0.015)
 
 
+@pytest.mark.parametrize("case", [None, "lift_off"])
+def test_cam_follower_model_file_keeps_contact_below_the_critical_speed_only(case):
+    scene = mb.load_model("models/cam_follower.toml", case=case)
+    res = scene.simulate()
+    p = scene.parameters
+    gap = np.array([scene.model.contact_gap("cam", q, t) for q, t in zip(res.q, res.t)])
+    lift = p["Rc"] + p["ecc"] * np.sin(p["Omega"] * res.t)
+    assert np.abs(res["y"] - gap - lift).max() < 1e-8        # the face on the profile
+    assert (gap.max() < 0) == (case is None)
+
+
 @pytest.mark.parametrize("follower", ["sphere", "cylinder"])
 def test_a_roller_follows_the_offset_circle(follower):
     """A roller of radius rho on the line x = 0 rides on the circle of radius RC + rho
