@@ -125,10 +125,22 @@ def test_newtons_cradle_passes_momentum_and_energy_down_the_row():
 
 
 def test_newtons_cradle_model_file_swings_the_last_ball_up():
+    """The first ball, a compound pendulum (length ``L + 0.4 r^2 / L`` equivalent),
+    touches the second past the bottom, at ``theta_c = -asin(gap / L)``: from ``theta0``
+    that takes ``sqrt(Le/g) (K(k) + F(phi_c, k))``, ``k = sin(theta0/2)``,
+    ``sin phi = sin(|theta|/2)/k``."""
+    from scipy.special import ellipk, ellipkinc
     scene = mb.load_model("models/newtons_cradle.toml")
     res = scene.simulate(t_end=0.5)
     first, last = res["swing1"], res["swing5"]
-    theta0 = scene.parameters["theta0"]
+    p = scene.parameters
+    theta0 = p["theta0"]
+    k = math.sin(theta0 / 2)
+    phi_c = math.asin(math.sin(math.asin(p["gap"] / p["L"]) / 2) / k)
+    Le = p["L"] + 0.4 * p["r"] ** 2 / p["L"]
+    onset = math.sqrt(Le / p["g"]) * (ellipk(k * k) + ellipkinc(phi_c, k * k))
+    assert [name for name, _ in res.events][0] == "first_impact"
+    assert res.events[0].t == pytest.approx(onset, rel=1e-7)
     assert np.abs(first[res.t > 0.3]).max() < 0.03 * theta0          # the first ball stops
     assert np.abs(last).max() == pytest.approx(theta0, rel=0.02)     # the last swings as high
 

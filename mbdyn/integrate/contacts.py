@@ -23,10 +23,21 @@ def contact_event(model, which, name=None, terminal=False, direction=-1):
     ``"contact"`` and the names joined by ``-``."""
     model.contact_gap(which, model.default_coordinates())     # refuse an unknown contact now
     label = name or "contact-" + (which if isinstance(which, str) else "-".join(which))
+    return Event(label, ContactGap(model, which), terminal, direction)
 
-    def gap(t, q, u):
-        return model.contact_gap(which, q, t)
-    return Event(label, gap, terminal, direction)
+
+class ContactGap:
+    """``g(t, q, u)``: the signed gap of a contact (``Model.contact_gap``), an event's
+    condition."""
+
+    def __init__(self, model, which):
+        self.model, self.which = model, which
+
+    def __call__(self, t, q, u):
+        return self.model.contact_gap(self.which, q, t)
+
+    def __repr__(self):
+        return f"<gap of contact {self.which!r}>"
 
 
 def warn_contact_step(model, integrator, max_step, stacklevel=3):

@@ -63,7 +63,9 @@ CONTACT_KEYS = {"name": "name", "pairs": "pairs", "group": "names", "stiffness":
                 "friction": "expr", "slip_speed": "expr", "broad_phase": "bool"}
 EFFECT_KEYS = {"gravity": "bool", "gyroscopic": "bool", "off": "names", "on": "names"}
 EVENT_KEYS = {"name": "name", "condition": "condition", "terminal": "bool",
-              "direction": "direction"}
+              "direction": "direction",
+              # instead of a condition: the gap of a contact (docs/contact.md)
+              "contact": "names"}
 
 #: section -> (layout, keys): "table" (fixed keys), "map" (any names -> expr),
 #: "array" (array of tables with a name each)
