@@ -576,3 +576,14 @@ def test_a_contact_is_an_effect_and_off_it_is_gone():
     with pytest.raises(mb.ModelError, match="unknown contact 'c'.*switched off"):
         off.contact_gap("c", q)
     assert "s0-s1; k = 1e+07" in on.force_element("c").describe()
+
+
+def test_pictures_draw_the_contact_shapes_where_they_are():
+    from mbdyn.viz.contact_shapes import contact_lines
+    model, q = one_pair("plane", {}, "box", {"half_sizes": (0.1, 0.05, 0.02)},
+                        ((0, 0, 0.3), None))
+    lines = contact_lines(model, model.kinematics(q, np.zeros(model.nu)))
+    assert len(lines) == 2 + 12                     # the plane's square and normal; 12 edges
+    box = np.vstack([pts for pts, _, _ in lines[2:]])
+    assert box.min(axis=0) == pytest.approx([-0.1, -0.05, 0.28])
+    assert box.max(axis=0) == pytest.approx([0.1, 0.05, 0.32])
