@@ -587,3 +587,11 @@ def test_pictures_draw_the_contact_shapes_where_they_are():
     box = np.vstack([pts for pts, _, _ in lines[2:]])
     assert box.min(axis=0) == pytest.approx([-0.1, -0.05, 0.28])
     assert box.max(axis=0) == pytest.approx([0.1, 0.05, 0.32])
+
+
+def test_info_describes_the_contact_and_its_event(capsys):
+    from mbdyn.cli import main
+    assert main(["info", "models/newtons_cradle.toml"]) == 0
+    out = capsys.readouterr().out
+    assert "balls          shape-contact: every pair of s1, s2, s3, s4, s5 (sweep and prune)" in out
+    assert "first_impact   gap of contact ['s1', 's2']  (falling)" in out

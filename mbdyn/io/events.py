@@ -30,8 +30,10 @@ def read_events(b, q0, u0):
                           "names must differ")
         seen.add(name)
         if "contact" in e:
-            events.append(_contact_event(b, path, e, name))
-            specs.append(dict(e))
+            event = _contact_event(b, path, e, name)
+            events.append(event)
+            specs.append({"name": name, "condition": f"gap of contact {e['contact']!r}",
+                          "terminal": event.terminal, "direction": WORDS[event.direction]})
             continue
         text = b.required(e, "condition", path, "event")
         try:
