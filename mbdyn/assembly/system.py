@@ -259,8 +259,7 @@ class System:
         self._forces[name] = el
         return name
 
-    add_shape = contacts.add_shape
-    add_contact = contacts.add_contact
+    add_shape, add_contact = contacts.add_shape, contacts.add_contact     # docs/contact.md
 
     def effect_names(self):
         """Every effect of the system: ``gravity``, ``gyroscopic``, loads, force elements."""
@@ -282,10 +281,6 @@ class System:
     @property
     def forces(self):
         return dict(self._forces)
-
-    @property
-    def shapes(self):
-        return dict(self._shapes)
 
     # ------------------------------------------------------------------ compile
     def topological_frames(self):
