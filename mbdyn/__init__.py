@@ -17,6 +17,7 @@ _PUBLIC = {
     "System": ".assembly.system", "GROUND": ".assembly.system",
     "Model": ".compiled.model", "Kinematics": ".algorithms.kinematics",
     "Result": ".integrate.result", "Event": ".integrate.events",
+    "contact_event": ".integrate.contacts",
     "simulate": ".integrate.simulation", "INTEGRATORS": ".integrate.settings",
     "FIXED_STEP": ".integrate.settings",
     "t": ".elements.values", "deg": ".elements.values",
@@ -36,7 +37,7 @@ __all__ = ["System", "Model", "Kinematics", "Result", "Event", "simulate", "iner
            "SingularMassMatrixError", "load_model", "Scene", "ModelFileError", "derive",
            "forces", "effects", "rotations", "equilibrium", "linearize", "modes", "campbell",
            "Equilibrium", "EquilibriumError", "Linearization", "Modes", "Campbell",
-           "sweep", "SweepResult"]
+           "sweep", "SweepResult", "contact_event"]
 
 
 #: public modules that live deeper in the package -> their module

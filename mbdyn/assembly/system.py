@@ -24,6 +24,7 @@ from ..errors import ModelError, ModelWarning, SingularMassMatrixError
 from ..limits import magnitude_problem
 from ..names import identifier_problem, label_problem
 from .actuation import add_actuator, add_controller, attach_plant, check_force
+from . import contacts
 from .composite import add_composite_joint
 from .loops import add_loop_joint, check_loops, loop_bodies
 from ..elements.forces import GLOBAL_EFFECTS, make_force
@@ -79,6 +80,7 @@ class System:
         self._loads = {}
         self._forces = {}
         self._controllers = {}          # name -> Controller (assembly.actuation)
+        self._shapes = {}             # contact shapes (assembly.contacts)
 
     # ------------------------------------------------------------------ building
     def symbols(self, names):
@@ -264,6 +266,7 @@ class System:
         called ``rate`` times a second; its efforts held between calls (zero-order hold)
         by one actuator per joint, ``NAME_JOINT``: the run between samples stays compiled."""
         return add_controller(self, name, function, rate, joints, limit)
+    add_shape, add_contact = contacts.add_shape, contacts.add_contact     # docs/contact.md
 
     def effect_names(self):
         """Every effect of the system: ``gravity``, ``gyroscopic``, loads, force elements."""

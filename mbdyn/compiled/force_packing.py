@@ -12,6 +12,7 @@ from ..elements.forces import BEARING_COEFFICIENTS, Table
 from ..kernels import forces as kf
 from ..kernels.actuation import PROGRAM
 from .actuator_packing import law_block, pack_actuator, pack_joint_stop
+from .contact_packing import pack_contact
 
 
 def _frame(model, name, element):
@@ -170,7 +171,8 @@ def _contact(model, el, element, row, data, laws):
 #: each force-element kind's packer: its row of integers and its numbers in the data
 _PACKERS = {"spring-damper": _spring_damper, "joint-spring-damper": _joint_spring_damper,
             "bushing": _bushing, "bearing": _bearing, "contact": _contact,
-            "actuator": pack_actuator, "joint-stop": pack_joint_stop}
+            "actuator": pack_actuator, "joint-stop": pack_joint_stop,
+            "shape-contact": pack_contact}
 
 
 def warn_outside_tables(model, t, u):

@@ -238,7 +238,8 @@ def workspace(model, joints):
     model._pA, model._cb, model._acc = np.zeros((n, 6)), np.zeros((n, 6)), np.zeros((n, 6))
     model._Dl, model._W = np.zeros((n, 6, 7)), np.zeros((n, 6))
     model._lam = np.zeros(len(model._react_joint))
-    model._scratch = np.zeros(ke.scratch_size(n, nu, model._nu_full))
+    model._scratch = np.zeros(max(ke.scratch_size(n, nu, model._nu_full),
+                                  getattr(model, "_force_work", 0)))   # contacts' broad phase
     model._slots = np.array(model._free_joint_slots, np.int64).reshape(-1, 5)
 
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..algorithms import closure, diagnosis, inputs, jourdain
+from ..algorithms import closure, contacts, diagnosis, inputs, jourdain
 from ..algorithms import constrained as loops
 from ..algorithms import loop_reactions as loop_reaction
 from ..algorithms import energy as energies
@@ -197,6 +197,7 @@ class Model:
     momentum = energies.momentum
     element_energy = energies.element_energy
     element_power = energies.element_power
+    contact_gap = contacts.contact_gap
     load_power = energies.load_power
     euler_singularity = diagnosis.euler_singularity
     # closed loops (``algorithms.constrained``, ``algorithms.closure``)

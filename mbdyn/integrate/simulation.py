@@ -22,6 +22,7 @@ from ..errors import ModelError, ModelWarning, SimulationError
 from . import compiled_adaptive, fixed_step, sampled, scipy_solvers
 from .budget import check_fixed_step, make_budget
 from .closed_loops import closed_initial_state, loop_report, release_rank
+from .contacts import warn_contact_step
 from .events import Event, as_event, check_conditions
 from .monitor import Monitor, conditioning
 from .plan import Plan, RightHandSide
@@ -82,10 +83,10 @@ def simulate(model, t_end, q0=None, u0=None, *, t0=0.0, integrator=DEFAULTS["int
     _check_kinds(model, events, progress)
     method = _check_method(model, integrator, method)
     t0, t_end = _check_interval(t0, t_end, events, rtol, atol, max_step)
+    warn_contact_step(model, integrator, max_step)
     budget = make_budget(max_steps, max_samples, max_wall_time, decimate)
-    budget["drives"] = [d[0] for d in getattr(model, "_driven", ())]
-    budget["integrator"] = integrator
-    budget.update(speeds=model.nu, span=t_end - t0)       # budget.warn_stiff's measures
+    budget.update(drives=[d[0] for d in getattr(model, "_driven", ())],  # warn_stiff's
+                  integrator=integrator, speeds=model.nu, span=t_end - t0)     # measures
     t_eval = _check_t_eval(t_eval, t0, t_end)
     q, u = _initial_state(model, q0, u0, t0)
     given_events = list(events)

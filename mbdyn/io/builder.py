@@ -22,6 +22,7 @@ from .expressions import ExpressionError, parse, symbol, to_float
 from .initial import read_initial
 from .settings import read_outputs, read_simulation
 from .system_sections import add_actuators, add_bodies, add_forces, add_joints, add_loads
+from .contact_sections import add_contacts, add_shapes
 from .urdf.section import add_section, read_section
 
 
@@ -174,6 +175,8 @@ class SceneBuilder:
         self.PTQ.update(self.names_q)
         self.load_specs = add_loads(self)
         self.force_specs = add_forces(self) + add_actuators(self)
+        self.shape_specs = add_shapes(self)
+        self.contact_specs = add_contacts(self)
         return system
 
     def parameters(self):

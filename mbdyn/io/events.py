@@ -8,6 +8,7 @@ import math
 import warnings
 
 from ..errors import ModelWarning
+from ..integrate.contacts import contact_event
 from ..integrate.events import Event
 from ..integrate.events import sympy_condition as _condition
 from .expressions import ExpressionError, parse_condition
@@ -28,6 +29,12 @@ def read_events(b, q0, u0):
             raise b.error(path + ("name",), f"a second event named {name!r}; event "
                           "names must differ")
         seen.add(name)
+        if "contact" in e:
+            event = _contact_event(b, path, e, name)
+            events.append(event)
+            specs.append({"name": name, "condition": f"gap of contact {e['contact']!r}",
+                          "terminal": event.terminal, "direction": WORDS[event.direction]})
+            continue
         text = b.required(e, "condition", path, "event")
         try:
             g, implied = parse_condition(text, b.PTQ)
@@ -63,3 +70,20 @@ def read_events(b, q0, u0):
         specs.append({"name": name, "condition": text, "terminal": terminal,
                       "direction": WORDS[direction]})
     return events, specs
+
+
+def _contact_event(b, path, e, name):
+    """An event on the gap of a contact: ``contact = "NAME"`` (a contact element) or
+    ``["SHAPE", "SHAPE"]`` (a pair); the onset (``"falling"``, the default), the release
+    (``"rising"``) or both (``"either"``)."""
+    if "condition" in e:
+        raise b.error(path + ("contact",), "an event takes a condition or a contact, not "
+                      "both")
+    which = e["contact"]
+    if isinstance(which, list) and len(which) != 2:
+        raise b.error(path + ("contact",), "must be a contact's name or two shape names")
+    direction = e.get("direction", -1)
+    direction = DIRECTIONS[direction] if isinstance(direction, str) else direction
+    with b.engine(path + ("contact",)):
+        return contact_event(b.model, which if isinstance(which, str) else tuple(which),
+                             name, bool(e.get("terminal", False)), int(direction))

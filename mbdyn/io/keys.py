@@ -4,7 +4,7 @@ of each key (``mbdyn.io.value_checks`` checks a value of each kind).
 from __future__ import annotations
 
 # value kinds: "string", "name", "expr", "vector", "axis", "inertia", "orientation",
-# "names", "bool", "condition", "direction", "reactions", ("choice", options)
+# "names", "bool", "condition", "direction", "reactions", "pairs", ("choice", options)
 MODEL_KEYS = {"name": "string", "description": "string", "gravity": "vector",
               "default_case": "string",
               # a URDF robot the file includes (docs/urdf.md)
@@ -61,9 +61,20 @@ ACTUATOR_KEYS = {"name": "name", "joint": "name", "kind": ("choice", ACTUATOR_KI
                  "stall_torque": "expr", "no_load_speed": "expr", "torque_speed": "table",
                  "gear": "expr", "rotor_inertia": "expr",
                  "interpolation": ("choice", ("pchip", "linear"))}
+#: contact shapes and contacts between them (docs/contact.md); not the drawing shape of a body
+CONTACT_SHAPE_KEYS = {"name": "name", "kind": ("choice", ("sphere", "plane", "box", "capsule",
+                                                          "cylinder", "cam")),
+                      "body": "name", "position": "vector", "radius": "expr", "normal": "axis",
+                      "half_sizes": "vector", "sizes": "vector", "orientation": "orientation",
+                      "length": "expr", "axis": "axis", "profile": "table"}
+CONTACT_KEYS = {"name": "name", "pairs": "pairs", "group": "names", "stiffness": "expr",
+                "exponent": "expr", "restitution": "expr", "impact_speed": "expr",
+                "friction": "expr", "slip_speed": "expr", "broad_phase": "bool"}
 EFFECT_KEYS = {"gravity": "bool", "gyroscopic": "bool", "off": "names", "on": "names"}
 EVENT_KEYS = {"name": "name", "condition": "condition", "terminal": "bool",
-              "direction": "direction"}
+              "direction": "direction",
+              # instead of a condition: the gap of a contact (docs/contact.md)
+              "contact": "names"}
 
 #: section -> (layout, keys): "table" (fixed keys), "map" (any names -> expr),
 #: "array" (array of tables with a name each)
@@ -75,6 +86,8 @@ SECTIONS = {
     "loads": ("array", LOAD_KEYS),
     "forces": ("array", FORCE_KEYS),
     "actuators": ("array", ACTUATOR_KEYS),
+    "shapes": ("array", CONTACT_SHAPE_KEYS),
+    "contacts": ("array", CONTACT_KEYS),
     "effects": ("table", EFFECT_KEYS),
     "initial": ("map", None),
     "initial_speeds": ("map", None),
@@ -85,5 +98,6 @@ SECTIONS = {
     "cases": ("cases", None),
 }
 ARRAY_ELEMENT = {"bodies": "body", "joints": "joint", "loads": "load", "forces": "force",
-                 "actuators": "actuator", "events": "event"}
+                 "actuators": "actuator", "shapes": "shape", "contacts": "contact",
+                 "events": "event"}
 DIRECTIONS = {"rising": 1, "falling": -1, "either": 0}

@@ -199,10 +199,22 @@ def _points(c, value, path):
         c.check_table(point, POINT_KEYS, path + (name,), required=("frame",))
 
 
+def _pairs(c, value, path):
+    if not isinstance(value, list) or not value:
+        raise c.error(path, f"must be an array of pairs of shape names, e.g. [[\"ball1\", "
+                      f"\"ball2\"]], got {show(value)}")
+    for i, pair in enumerate(value):
+        if not isinstance(pair, list) or len(pair) != 2:
+            raise c.error(path + (i,), f"must be two shape names [\"a\", \"b\"], got "
+                          f"{show(pair)}")
+        for k, n in enumerate(pair):
+            _name(c, n, path + (i, k))
+
+
 #: kind -> its check
 CHECKS = {"string": _string, "name": _name, "bool": _boolean, "expr": _expression,
           "vector": _vector, "axis": _axis, "inertia": _inertia, "orientation": _orientation,
           "names": _names, "condition": _condition, "direction": _direction,
           "reactions": _reactions, "shape": _shape, "exprs": _expressions,
           "coefficient": _coefficient, "matrix6": _matrix6, "table": _table,
-          "points": _points, "signal": _signal}
+          "points": _points, "signal": _signal, "pairs": _pairs}

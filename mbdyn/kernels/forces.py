@@ -25,6 +25,7 @@ import math
 from numba import njit
 
 from .actuation import PROGRAM, PROGRAM_WORK, actuator_effort, program_value, stop_effort
+from .contact import CONTACT_SHAPES, shape_contacts
 from .linalg3 import cross_to, mat_t_vec, mat_vec
 from .tables import LINEAR, NO_TABLE, PCHIP, table_eval  # noqa: F401
 from .views import UNCOUNTED
@@ -246,6 +247,8 @@ def force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r,
                 for q in range(3):
                     P += f[q] * (va[q] - vb[q])
                 acc[1] += P
+        elif kind == CONTACT_SHAPES:       # between shapes: kernels/contact.py
+            shape_contacts(off, force_data, R, r, w, v, com, F, N, acc, want, work[FORCE_WORK:])
         else:
             _contact(kind, ia, off, force_data, R, r, w, v, com, F, N, acc, want,
                      pa, va, d, f, lever, t, e1, zero)

@@ -182,11 +182,18 @@ def contact(walk, el, law):
     walk._add_wrench(el.name, a, f, Z3, own)
 
 
+def shape_contact(walk, el, law):
+    raise ModelError(f"contact {el.name!r}: contact between shapes (a broad phase, nearest "
+                     "points, cam profiles) has no closed form in the symbolic layer; switch "
+                     f"it off to derive the rest (--effects=-{el.name})")
+
+
 #: each force-element kind's wrenches
 KINDS = {"spring-damper": spring_damper, "joint-spring-damper": joint_spring_damper,
          "bushing": bushing, "bearing": bearing, "contact": contact,
          "joint-stop": lambda walk, el, law: joint_stop(walk, el),
-         "actuator": lambda walk, el, law: actuator(walk, el)}
+         "actuator": lambda walk, el, law: actuator(walk, el),
+         "shape-contact": shape_contact}
 
 
 def joint_stop(walk, el):

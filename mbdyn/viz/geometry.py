@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
+from .contact_shapes import contact_lines
 
 #: colours of a frame's x, y, z axes (red, green, blue)
 AXES = ("#e41a1c", "#4daf4a", "#377eb8")
@@ -115,6 +116,7 @@ def instant(model, geometry, q, u, t):
             markers.append((g["name"], kin.r_com[i].copy(), g["color"], g["size"]))
     if getattr(model, "has_loops", False):
         lines.extend(loop_lines(model, kin))
+    lines.extend(contact_lines(model, kin))
     return Scene3D(float(t), lines, markers, {})
 
 
