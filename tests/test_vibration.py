@@ -356,3 +356,20 @@ def test_geometric_stiffness_of_a_preloaded_spring():
         assert lin.K[0, 0] == pytest.approx(T / L, rel=1e-7), route
     assert mb.modes(mb.linearize(model))[0].natural_frequency == pytest.approx(
         np.sqrt(T / (L * m)), rel=1e-7)
+
+def test_a_guess_where_newton_cannot_start_settles_by_dynamic_relaxation():
+    # an arm held horizontal: gravity's torque has no stiffness there (a singular
+    # Jacobian), so Newton and scipy's root fail from it; the model settles hanging down
+    import math
+    s = mb.System("arm", gravity=(0, 0, -9.81))
+    s.add_body("upper", mass=2.0, com=(0.3, 0, 0), inertia=(0.01, 0.05, 0.05))
+    s.add_joint("shoulder", "revolute", parent="ground", child="upper", axis="y")
+    s.add_body("fore", mass=1.0, com=(0.25, 0, 0), inertia=(0.005, 0.02, 0.02))
+    s.add_joint("elbow", "revolute", parent="upper", child="fore", axis="y",
+                position=(0.6, 0, 0))
+    m = s.compile()
+    eq = mb.equilibrium(m)
+    assert eq.method == "dynamic relaxation, then newton"
+    # hanging: both links along -z, i.e. shoulder = +pi/2 about y, elbow = 0
+    assert abs(math.remainder(eq.q[0] - math.pi / 2, 2 * math.pi)) < 1e-9
+    assert abs(eq.q[1]) < 1e-9 and eq.residual < 1e-9

@@ -135,7 +135,13 @@ def equilibrium(model, q_guess=None, u=None, t=0.0, fixed=(), tol=1e-10, max_ite
     method = "newton"
     if np.abs(r).max() > tol * scale:
         method = "scipy.optimize.root (hybr)"
-        x, r, iterations, cond = _fallback(eqs, x, r, tol, scale, iterations)
+        try:
+            x, r, iterations, cond = _fallback(eqs, x, r, tol, scale, iterations)
+        except EquilibriumError:
+            if fixed or np.any(u):
+                raise
+            eqs, x, r, iterations, cond = _relaxed(model, q0, t, tol, scale, max_iter)
+            method = "dynamic relaxation, then newton"
     q = eqs.configuration(x)
     model.normalize_quaternions(q)
     _warn_if_singular(model, q)
@@ -307,6 +313,25 @@ def _fallback(eqs, x, r, tol, scale, iterations):
         f"fallback); try another guess, hold cyclic coordinates fixed, or check "
         "that the model can rest (a spinning body needs its spin speed in u)",
         last=eqs.configuration(x), residual=float(np.abs(r).max()))
+
+
+def _relaxed(model, q0, t, tol, scale, max_iter):
+    """Newton-Raphson from where the model settles (``relaxation.relax``): a static
+    equilibrium that Newton could not reach from the guess."""
+    from .relaxation import relax
+    q = relax(model, q0, t)
+    if q is None:
+        raise EquilibriumError(f"model {model.name!r}: no equilibrium found from the guess, "
+                               "and the model does not settle from it either (Newton, "
+                               "scipy's root and a damped relaxation failed); give a guess "
+                               "near the rest position", last=q0)
+    tangent = Tangent(model, q)
+    eqs = _Equations(model, tangent, list(range(tangent.n)), np.zeros(model.nu), t)
+    x = np.zeros(tangent.n)
+    x, r, iterations, cond = _newton(eqs, x, eqs.residual(x), tol, scale, max_iter)
+    if np.abs(r).max() > tol * scale:
+        x, r, iterations, cond = _fallback(eqs, x, r, tol, scale, iterations)
+    return eqs, x, r, iterations, cond
 
 
 def _warn_if_singular(model, q):
