@@ -228,3 +228,24 @@ def momentum(model, q, u, t=0.0):
         p = p + p_i
         L = L + R @ P[3:6] + np.cross(tree._r[i], p_i)
     return p, L
+
+
+def modal_power(model, q, u, t=0.0):
+    """The power of the flexible bodies' forces that no potential gives: modal damping
+    ``-eta'^T D eta'`` and, with ``geometric_stiffening``, ``-eta'^T K_G eta`` (its
+    axial part reads the frame's acceleration, so ``u'`` is computed)."""
+    q, u = split(model, q, u)
+    P = sum(-u[fb.u] @ fb.damping @ u[fb.u] for fb in model._flex)
+    if not model.stiffening:
+        return float(P)
+    ud = forward_dynamics(model, q, u, t)      # leaves the tree's kinematics at (q, u)
+    tree = model.tree
+    omegas = _angular_velocities(model, q, u, t)
+    for fb in model._flex:
+        RT = tree._R[fb.frame].T
+        omega = RT @ tree._w[fb.frame] if omegas is None else omegas[fb.frame]
+        a_x = (body_map(tree, fb, model.nu)[0] @ ud + (RT @ tree._a[fb.frame])[0]
+               - (RT @ tree.gravity)[0])
+        Kg = (omega[1] ** 2 + omega[2] ** 2) * fb.centrifugal + a_x * fb.axial
+        P -= u[fb.u] @ Kg @ q[fb.q]
+    return float(P)

@@ -112,6 +112,12 @@ class FlexibleModel(Model):
         return True
 
     @property
+    def flexible_forces(self):
+        """True when modal damping or the geometric stiffening (forces no potential
+        gives) act: ``T + V`` alone is then not conserved."""
+        return self.stiffening or any(fb.damping.any() for fb in self._flex)
+
+    @property
     def has_loops(self):
         return False
 
@@ -148,8 +154,19 @@ class FlexibleModel(Model):
         return self.tree.point_positions(np.asarray(q, float)[:self.tree.nq], points, t)
 
     def element_power(self, q, u, t=0.0):
-        return self.tree.element_power(np.asarray(q, float)[:self.tree.nq],
-                                       np.asarray(u, float)[:self.tree.nu], t)
+        """The force elements' ``(V, P_nc, P_actuators)``, the flexible bodies' modal
+        damping and geometric stiffening counted in ``P_nc`` (``modal_power``)."""
+        V, P_nc, P_act = self.tree.element_power(np.asarray(q, float)[:self.tree.nq],
+                                                 np.asarray(u, float)[:self.tree.nu], t)
+        return V, P_nc + flex.modal_power(self, q, u, t), P_act
+
+    def u_vector(self, values=None):
+        """As ``Model.u_vector``; a modal coordinate's name stands for its rate too."""
+        if isinstance(values, dict):
+            rates = {c: s for r in self.flexible.values()
+                     for c, s in zip(r.coordinates, r.speeds)}
+            values = {rates.get(k, k): v for k, v in values.items()}
+        return Model.u_vector(self, values)
 
     def element_energy(self, q, u, t=0.0):
         V, P_nc, P_act = self.element_power(q, u, t)
