@@ -17,7 +17,7 @@ import sympy
 from ..compiled.model import Model
 from ..elements.effects import parse_effects, warn_if_unphysical
 from ..elements.values import has_symbols, numeric
-from ..elements.bodies import inertia_tensor, make_body
+from ..elements.bodies import inertia_tensor, make_body, origin_inertia_parts
 from ..elements.joints import make_joint
 from ..elements.loads import make_load
 from ..errors import ModelError, ModelWarning, SingularMassMatrixError
@@ -26,6 +26,7 @@ from ..names import identifier_problem, label_problem
 from .actuation import add_actuator, add_controller, attach_plant, check_force
 from . import contacts
 from .composite import add_composite_joint
+from . import flexible as flex
 from .loops import add_loop_joint, check_loops, loop_bodies
 from ..elements.forces import GLOBAL_EFFECTS, make_force
 
@@ -81,6 +82,7 @@ class System:
         self._forces = {}
         self._controllers = {}          # name -> Controller (assembly.actuation)
         self._shapes = {}             # contact shapes (assembly.contacts)
+        self._flexible = {}             # name -> FlexibleBody (assembly.flexible)
 
     # ------------------------------------------------------------------ building
     def symbols(self, names):
@@ -109,14 +111,16 @@ class System:
                              "choose another name")
 
     def add_body(self, name, mass=0.0, com=(0, 0, 0), inertia=None, shape=None,
-                 inertia_about="com"):
+                 inertia_about="com", flexible=None):
         """A rigid body: ``mass``, centre of mass ``com`` in body components (from the
         frame origin), ``inertia`` about the centre of mass in body axes -- ``None``/0 for a
         particle, three principal moments, or a 3x3 tensor (see ``mbdyn.inertia``).
         ``shape``: how pictures draw it (``mbdyn.elements.bodies.make_shape``).
         ``inertia_about="origin"``: the inertia is given about the frame origin instead (as
         the textbook's top data are); it is moved to the centre of mass by the parallel-axis
-        theorem, ``I_G = I_O - m (|c|^2 E - c c^T)``."""
+        theorem, ``I_G = I_O - m (|c|^2 E - c c^T)``.  ``flexible``: a modally reduced
+        flexible body whose frame is the beam's root (``mbdyn.elements.flexible_bodies``,
+        docs/flexible.md); ``mass``, ``com``, ``inertia`` are then a rigid part fixed to it."""
         self._check_new_frame(name)
         if inertia_about not in ("com", "origin"):
             raise ModelError(f"body {name!r}: inertia_about must be 'com' or 'origin', got "
@@ -124,10 +128,12 @@ class System:
         if inertia_about == "origin":
             if inertia is None:
                 raise ModelError(f"body {name!r}: inertia_about='origin' needs an inertia")
-            I_O, c, mass = _origin_inertia_parts(name, mass, com, inertia)
+            I_O, c, mass = origin_inertia_parts(name, mass, com, inertia)
             I_G = I_O - mass * ((c.T * c)[0, 0] * sympy.eye(3) - c * c.T)
             inertia = [[float(v) if not getattr(v, "free_symbols", None) else v
                         for v in I_G.row(r)] for r in range(3)]
+        if flexible is not None:
+            return flex.add_flexible_body(self, name, mass, com, inertia, shape, flexible)
         self.graph.add_node(name, body=make_body(name, mass, com, inertia, self.parameters,
                                                  shape))
         return name
@@ -270,7 +276,8 @@ class System:
 
     def effect_names(self):
         """Every effect of the system: ``gravity``, ``gyroscopic``, loads, force elements."""
-        return GLOBAL_EFFECTS + tuple(self._loads) + tuple(self._forces)
+        return (GLOBAL_EFFECTS + tuple(self._loads) + tuple(self._forces)
+                + flex.effect_names(self))
 
     # ------------------------------------------------------------------ inspection
     @property
@@ -316,6 +323,7 @@ class System:
         if not order:
             raise ModelError(f"system {self.name!r} has no bodies; add bodies and joints")
         bodies = [self.graph.nodes[n]["body"] for n in order]
+        flexible = flex.flexible_on(self, order, state)
         joints = [next(iter(self.graph.in_edges(n, data="joint")))[2] for n in order]
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
@@ -323,7 +331,7 @@ class System:
                 inertia_tensor(b.inertia, f"body {b.name!r}")
         found = [str(w.message) for w in caught if issubclass(w.category, ModelWarning)]
         gravity = self.gravity if state["gravity"] else np.zeros(3)
-        model = Model(self.name, bodies, joints,
+        model = Model(self.name, flex.massless(bodies, flexible), joints,
                       [ld for ld in self._loads.values() if state[ld.name]], gravity,
                       warnings=found, parameters=self.parameters,
                       gravity_symbolic=self.gravity_symbolic if state["gravity"] else None,
@@ -331,6 +339,7 @@ class System:
                       effects=state, loop_joints=loop_joints,
                       controllers=[c for c in self._controllers.values()
                                    if any(state[a] for a in c.actuators)])
+        model = flex.flexible_model(model, flexible, state)
         if check_inertia and model.nu and not loop_joints:
             _check_inertia_of_every_dof(model)
         model.loops = {j.name: loop_bodies(self, j) for j in loop_joints}
@@ -371,30 +380,3 @@ def _check_inertia_of_every_dof(model, samples=3, seed=12345):
                      "Give the bodies these joints move mass or inertia about the joint axes, "
                      "or remove (fix) those joints." + hint)
 
-
-def _origin_inertia_parts(name, mass, com, inertia):
-    """``(I_O, c, m)`` as sympy objects for ``inertia_about="origin"``: the inertia about
-    the origin (three principal moments or a 3x3 tensor), the centre of mass (three
-    values) and the mass (a number or an expression), each checked first."""
-    element = f"body {name!r}"
-    if not (isinstance(mass, (int, float, sympy.Basic)) and not isinstance(mass, bool)):
-        raise ModelError(f"{element}: mass must be a number or an expression of parameters, "
-                         f"got {mass!r}")
-    shape = np.shape(np.asarray(inertia, dtype=object))
-    if shape not in ((3,), (3, 3)):
-        raise ModelError(f"{element}: inertia_about='origin' takes three principal moments "
-                         f"or a 3x3 tensor, got {inertia!r}")
-    if np.shape(np.asarray(com, dtype=object)) != (3,):
-        raise ModelError(f"{element}: com must be three values, got {com!r}")
-    entries = list(np.ravel(np.asarray(inertia, dtype=object))) + list(com)
-    if not all(isinstance(v, (int, float, np.number, sympy.Basic)) and not isinstance(v, bool)
-               for v in entries):
-        raise ModelError(f"{element}: inertia and com must be numbers or sympy expressions "
-                         "of parameters")
-    try:
-        I_O = sympy.Matrix(np.diag(inertia) if shape == (3,) else inertia)
-        c = sympy.Matrix(list(com))
-    except (TypeError, ValueError, sympy.SympifyError):
-        raise ModelError(f"{element}: inertia and com must be numbers or expressions of "
-                         "parameters") from None
-    return I_O, c, mass

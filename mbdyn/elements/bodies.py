@@ -9,6 +9,7 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
+import sympy
 
 from ..errors import ModelError, ModelWarning
 from .values import _vector3, has_symbols, numeric, parse_axis, square_matrix
@@ -134,3 +135,31 @@ def inertia_tensor(inertia, element):
                       "no real body has them.  Check the data (e.g. moments given about another "
                       "point than the centre of mass).", ModelWarning, stacklevel=4)
     return arr
+
+
+def origin_inertia_parts(name, mass, com, inertia):
+    """``(I_O, c, m)`` as sympy objects for ``inertia_about="origin"``: the inertia about
+    the origin (three principal moments or a 3x3 tensor), the centre of mass (three
+    values) and the mass (a number or an expression), each checked first."""
+    element = f"body {name!r}"
+    if not (isinstance(mass, (int, float, sympy.Basic)) and not isinstance(mass, bool)):
+        raise ModelError(f"{element}: mass must be a number or an expression of parameters, "
+                         f"got {mass!r}")
+    shape = np.shape(np.asarray(inertia, dtype=object))
+    if shape not in ((3,), (3, 3)):
+        raise ModelError(f"{element}: inertia_about='origin' takes three principal moments "
+                         f"or a 3x3 tensor, got {inertia!r}")
+    if np.shape(np.asarray(com, dtype=object)) != (3,):
+        raise ModelError(f"{element}: com must be three values, got {com!r}")
+    entries = list(np.ravel(np.asarray(inertia, dtype=object))) + list(com)
+    if not all(isinstance(v, (int, float, np.number, sympy.Basic)) and not isinstance(v, bool)
+               for v in entries):
+        raise ModelError(f"{element}: inertia and com must be numbers or sympy expressions "
+                         "of parameters")
+    try:
+        I_O = sympy.Matrix(np.diag(inertia) if shape == (3,) else inertia)
+        c = sympy.Matrix(list(com))
+    except (TypeError, ValueError, sympy.SympifyError):
+        raise ModelError(f"{element}: inertia and com must be numbers or expressions of "
+                         "parameters") from None
+    return I_O, c, mass

@@ -39,7 +39,7 @@ from .beam import Attachment, Beam, nearest_node
 from .sections import KINDS, make_section
 
 THEORIES = ("timoshenko", "euler-bernoulli")
-SEGMENT_KEYS = ("length", "elements", "circle", "tube", "rect", "E", "rho", "nu")
+SEGMENT_KEYS = ("length", "elements", "circle", "tube", "rect", "section", "E", "rho", "nu")
 BEAM_KEYS = ("theory", "rotary_inertia", "segments", "masses", "nodes")
 MASS_KEYS = ("at", "mass", "polar", "diametral")
 
@@ -72,6 +72,7 @@ def _segment(table, key):
     if not isinstance(table, dict):
         raise ModelError(f"{key}: must be a table of length, elements, a section, E, rho, nu")
     _unknown(table, SEGMENT_KEYS, key)
+    table = _with_section(table, key)
     length = _number(table, "length", key, low=0.0)
     elements = table.get("elements", 1)
     if isinstance(elements, bool) or not isinstance(elements, numbers.Integral) or elements < 1:
@@ -87,6 +88,24 @@ def _segment(table, key):
         raise ModelError(f"{key}.nu: Poisson's ratio must lie in (-1, 0.5), got {nu!r}")
     section = make_section(kinds[0], table[kinds[0]], nu, f"{key}.{kinds[0]}")
     return length, elements, section, E, rho, nu
+
+
+def _with_section(table, key):
+    """``section = { circle = d }`` (or ``tube``, ``rect``) written as the segment's own
+    ``circle = d``: the two spellings are the same beam."""
+    if "section" not in table:
+        return table
+    section = table["section"]
+    if not isinstance(section, dict) or len(section) != 1 or next(iter(section)) not in KINDS:
+        raise ModelError(f"{key}.section: give exactly one of circle = d, tube = [d_out, "
+                         f"d_in], rect = [b, h] in it, e.g. section = {{ circle = 0.02 }}; "
+                         f"got {section!r}")
+    if any(k in table for k in KINDS):
+        raise ModelError(f"{key}.section: the section is also given as "
+                         f"{', '.join(k for k in KINDS if k in table)}; keep one")
+    out = {k: v for k, v in table.items() if k != "section"}
+    out.update(section)
+    return out
 
 
 def _segments(spec, key):

@@ -67,9 +67,10 @@ def energy_balance(model, t, q, u):
     P_nc = np.zeros(n)
     P_in = np.zeros(n)
     drives = [(name, drive) for name, _, _, drive in model._driven]
+    flexible = getattr(model, "flexible_bodies", ())   # modal damping, stiffening's power
     for k in range(n):
         T[k], V[k] = model.energy(q[k], u[k], t[k])
-        if model.forces:
+        if model.forces or flexible:
             v_el, P_nc[k], P_act = model.element_power(q[k], u[k], t[k])
             V[k] += v_el
             P_in[k] += P_act

@@ -73,7 +73,8 @@ def difference(coarse, fine):
 def conservative(model):
     """Gravity the only force: no loads, drives or force elements, so ``T + V`` is
     constant along the exact motion, with no quadrature in its balance."""
-    return not (model.loads or model.driven_joints or getattr(model, "forces", None))
+    return not (model.loads or model.driven_joints or getattr(model, "forces", None)
+                or getattr(model, "flexible_forces", False))
 
 
 def energy_drift(result):

@@ -45,7 +45,21 @@ def _driven_and_rates(system):
     for j in system.joints.values():
         if j.drive is None and j.kind in ("revolute", "prismatic", "euler"):
             rates.update(zip(j.coordinates, j.speeds))
+    for body in system._flexible.values():      # modal coordinates: u = q'
+        rates.update(zip(body.coordinates, body.speeds))
     return driven, rates
+
+
+def _modal_off(b, name, path):
+    """True (with a warning) for a modal coordinate or speed of a flexible body whose
+    flexibility the scene switched off: the body is rigid, its value is not used."""
+    for body in b.system._flexible.values():
+        if name in body.coordinates + body.speeds:
+            warnings.warn(f"{'.'.join(map(str, path))}: body {body.name!r} is rigid in this "
+                          "scene (flexibility_" f"{body.name} is off); {name} is ignored",
+                          ModelWarning, stacklevel=4)
+            return True
+    return False
 
 
 def _coordinates(b, driven):
@@ -54,6 +68,8 @@ def _coordinates(b, driven):
     for k, v in b.doc.get("initial", {}).items():
         path = ("initial", k)
         if k not in model.coordinates:
+            if _modal_off(b, k, path):
+                continue
             if k in driven:
                 raise b.error(path, f"is the coordinate of driven joint "
                               f"{driven[k]!r}; its motion comes from the drive -- "
@@ -72,6 +88,8 @@ def _speeds(b, driven, rates):
         path = ("initial_speeds", k)
         if k in model.speeds:
             target = k
+        elif _modal_off(b, k, path):
+            continue
         elif k in rates:
             target = rates[k]
         else:
@@ -117,6 +135,8 @@ def _guess(b, driven, held):
     for k, v in b.doc.get("guess", {}).items():
         path = ("guess", k)
         if k not in model.coordinates:
+            if _modal_off(b, k, path):
+                continue
             if k in driven:
                 raise b.error(path, f"is the coordinate of driven joint {driven[k]!r}; the "
                               "drive gives it -- remove it here")

@@ -10,7 +10,9 @@ MODEL_KEYS = {"name": "string", "description": "string", "gravity": "vector",
               # a URDF robot the file includes (docs/urdf.md)
               "urdf": "string", "floating": "bool", "accept_inertia": "bool"}
 BODY_KEYS = {"name": "name", "mass": "expr", "com": "vector", "inertia": "inertia",
-             "inertia_about": ("choice", ("com", "origin")), "shape": "shape"}
+             "inertia_about": ("choice", ("com", "origin")), "shape": "shape",
+             # a modally reduced flexible body (docs/flexible.md)
+             "flexible": "flexible"}
 SHAPE_KEYS = {"type": ("choice", ("sphere", "box", "cylinder", "disk", "rod")),
               "radius": "expr", "length": "expr", "size": "vector", "center": "vector",
               "start": "vector", "end": "vector", "axis": "axis", "color": "string"}

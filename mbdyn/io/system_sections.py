@@ -5,6 +5,8 @@ the entries as written (the ``Scene``'s ``*_specs``).
 """
 from __future__ import annotations
 
+from pathlib import Path
+
 import sympy
 
 from .. import limits
@@ -41,10 +43,22 @@ def add_bodies(b):
             for key in ("center", "start", "end", "size"):
                 if key in shape:
                     shape[key] = b.numbers(shape[key], path + ("shape", key))
-        with b.engine(path):
-            b.system.add_body(name, mass=mass, com=com, inertia=inertia, shape=shape)
+        flexible = _flexible(b, body.get("flexible"))
+        with b.engine(path + (("flexible",) if flexible is not None else ())):
+            b.system.add_body(name, mass=mass, com=com, inertia=inertia, shape=shape,
+                              flexible=flexible)
         specs.append(dict(body))
     return specs
+
+
+def _flexible(b, spec):
+    """A ``flexible`` table with its ``data`` file found beside the model file."""
+    if spec is None or "data" not in spec or not isinstance(spec["data"], str):
+        return spec
+    data = Path(spec["data"])
+    if not data.is_absolute() and b.path is not None:
+        data = Path(b.path).parent / data
+    return {**spec, "data": str(data)}
 
 
 def inertia_about_com(inertia, mass, com):

@@ -211,10 +211,23 @@ def _pairs(c, value, path):
             _name(c, n, path + (i, k))
 
 
+def _flexible(c, value, path):
+    """A flexible body's table: its keys here, their values when the body is built
+    (``mbdyn.elements.flexible_bodies``, every error naming its key)."""
+    from ..elements.flexible_bodies import KEYS
+    if not isinstance(value, dict):
+        raise c.error(path, "must be a table, e.g. { beam = { length = 1.0, elements = 10, "
+                      "E = 2.1e11, rho = 7850, circle = 0.02 }, modes = 4 } or "
+                      "{ data = \"blade.npz\" }")
+    for k in value:
+        if k not in KEYS:
+            raise c.error(path + (k,), f"unknown key; the keys here are: {', '.join(KEYS)}")
+
+
 #: kind -> its check
 CHECKS = {"string": _string, "name": _name, "bool": _boolean, "expr": _expression,
           "vector": _vector, "axis": _axis, "inertia": _inertia, "orientation": _orientation,
           "names": _names, "condition": _condition, "direction": _direction,
           "reactions": _reactions, "shape": _shape, "exprs": _expressions,
           "coefficient": _coefficient, "matrix6": _matrix6, "table": _table,
-          "points": _points, "signal": _signal, "pairs": _pairs}
+          "points": _points, "signal": _signal, "pairs": _pairs, "flexible": _flexible}

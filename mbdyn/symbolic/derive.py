@@ -40,6 +40,15 @@ FINISH_BUDGET = 5000
 
 
 def _as_model(model_or_system):
+    model = _model_of(model_or_system)
+    if getattr(model, "flexible_bodies", ()):
+        raise ModelError(f"model {model.name!r}: the symbolic layer does not know flexible "
+                         f"bodies ({', '.join(model.flexible_bodies)}) yet; use a numeric "
+                         "method (method='auto'), or switch their flexibility off")
+    return model
+
+
+def _model_of(model_or_system):
     from ..compiled.model import Model
     if isinstance(model_or_system, Model):
         return model_or_system

@@ -70,6 +70,9 @@ class Walk:
     def __init__(self, model, frames="own", simplify="compact", max_nodes=None):
         if frames not in FRAMES:
             raise ModelError(f"unknown frames {frames!r}; use one of {', '.join(FRAMES)}")
+        if getattr(model, "flexible_bodies", ()):
+            raise ModelError(f"model {model.name!r}: the symbolic layer does not know "
+                             f"flexible bodies ({', '.join(model.flexible_bodies)}) yet")
         self.model = model
         self.frames = frames
         self.simplify = simplify

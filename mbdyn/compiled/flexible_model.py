@@ -1,0 +1,195 @@
+"""``FlexibleModel``: a compiled model with flexible bodies (modal coordinates).
+
+It holds the tree compiled as every model is (``model.tree``, a ``Model``), with its
+flexible bodies as massless frames there, and per flexible body what its terms read
+(``FlexPack``: invariants, modal mass, stiffness, damping, geometric stiffness).  The
+free coordinates and speeds are the tree's, then each flexible body's modal coordinates
+``BODY_m1 ...`` and rates ``BODY_m1_dot ...``, in tree order: appended, so that every
+index into the tree's state (quaternions, Euler angles, events, drives) stays valid in
+the model's.  Its dynamics are ``algorithms.flexible_dynamics`` (Python, Jourdain);
+anything else it reads from the tree by name (``__getattr__``), and the routes that are
+not there yet for flexible bodies say so.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..algorithms import flexible_dynamics as flex
+from ..errors import ModelError
+from .model import Model
+
+
+@dataclass(frozen=True, eq=False)
+class FlexPack:
+    """One flexible body as its terms read it: the tree's ``frame`` index, its slices
+    ``q`` and ``u`` of the model's state, ``n`` modes, the ``invariants`` (with the rigid
+    part fixed to it), modal ``mass``, ``stiffness``, ``damping``, and the geometric
+    stiffness per unit ``omega_y^2 + omega_z^2`` (``centrifugal``) and per unit
+    ``a_x - g_x`` (``axial``): zero for reduced data, which carry none."""
+    name: str
+    frame: int
+    q: slice
+    u: slice
+    n: int
+    invariants: object
+    mass: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    centrifugal: np.ndarray
+    axial: np.ndarray
+
+
+def pack_flexible(tree, records):
+    """The ``FlexPack`` of each ``FlexibleBody`` in ``records`` (tree order), their modal
+    coordinates after the tree's."""
+    packs, nq, nu = [], tree.nq, tree.nu
+    for rec in records:
+        red, n = rec.reduced, rec.n_modes
+        zero = np.zeros((n, n))
+        packs.append(FlexPack(
+            rec.name, tree.frame_index(rec.name), slice(nq, nq + n), slice(nu, nu + n), n,
+            rec.invariants, red.mass_matrix, red.stiffness_matrix, red.damping_matrix,
+            red.geometric_stiffness.get("centrifugal", zero),
+            red.geometric_stiffness.get("axial_acceleration", zero)))
+        nq, nu = nq + n, nu + n
+    return tuple(packs)
+
+
+def _not_yet(what):
+    def refuse(self, *args, **kwargs):
+        raise ModelError(f"model {self.name!r} has flexible bodies "
+                         f"({', '.join(self.flexible_bodies)}): {what} is not there yet for "
+                         "them (the next step); switch their flexibility off "
+                         f"(effects: -{self.tree_effect_example}) to use it")
+    refuse.__name__ = what
+    return refuse
+
+
+class FlexibleModel(Model):
+    """A compiled model with flexible bodies; build it with ``System.compile()``."""
+
+    def __init__(self, tree, records, stiffening=True):
+        # not Model.__init__: the tree is compiled already, and read through __getattr__
+        self.tree = tree
+        self.name = tree.name
+        self.stiffening = bool(stiffening)
+        self.flexible_bodies = tuple(r.name for r in records)
+        self.flexible = {r.name: r for r in records}
+        self._flex = pack_flexible(tree, records)
+        self.coordinates = tree.coordinates + sum((r.coordinates for r in records), ())
+        self.speeds = tree.speeds + sum((r.speeds for r in records), ())
+        self.nq, self.nu = len(self.coordinates), len(self.speeds)
+        self._coordinate_index = {c: k for k, c in enumerate(self.coordinates)}
+        self._speed_index = {c: k for k, c in enumerate(self.speeds)}
+        self._body = {**tree._body, **{r.name: r.rigid for r in records}}
+        self.bodies = tuple(f for f in tree.frames if f in self._body
+                            and self._body[f].has_inertia)
+        self.tree_effect_example = f"flexibility_{records[0].name}"
+        tree._full_workspace()        # the Jacobians and M the terms read
+
+    def __getattr__(self, name):
+        tree = self.__dict__.get("tree")
+        if tree is None:
+            raise AttributeError(name)
+        return getattr(tree, name)
+
+    def __repr__(self):
+        return (f"<FlexibleModel {self.name!r}: {self.n_frames} frames, flexible "
+                f"{', '.join(self.flexible_bodies)}, nq={self.nq}, nu={self.nu}>")
+
+    def describe_speeds(self, speeds):
+        tree = [s for s in speeds if s in self.tree._speed_index]
+        modal = [s for s in speeds if s not in self.tree._speed_index]
+        parts = ([self.tree.describe_speeds(tree)] if tree else []) + (
+            [f"{', '.join(modal)} (modal)"] if modal else [])
+        return "; ".join(parts) or "some coordinates"
+
+    @property
+    def has_callable_loads(self):
+        """True: the flexible bodies' terms are Python, so runs take the Python routes."""
+        return True
+
+    @property
+    def flexible_forces(self):
+        """True when modal damping or the geometric stiffening (forces no potential
+        gives) act: ``T + V`` alone is then not conserved."""
+        return self.stiffening or any(fb.damping.any() for fb in self._flex)
+
+    @property
+    def has_loops(self):
+        return False
+
+    def formulation(self, method="auto"):
+        """``"jourdain"`` for ``"auto"`` and ``"jourdain"``; the other routes are refused."""
+        if method in ("auto", "jourdain"):
+            return "jourdain"
+        raise ModelError(f"model {self.name!r} has flexible bodies "
+                         f"({', '.join(self.flexible_bodies)}): only method 'jourdain' (or "
+                         f"'auto') is there for them, in Python; {method!r} is the next "
+                         "step")
+
+    # the tree's frames: their motion does not depend on the modal coordinates
+    def kinematics(self, q, u=None, ud=None, t=0.0):
+        nqt, nut = self.tree.nq, self.tree.nu
+        return self.tree.kinematics(np.asarray(q, float)[:nqt],
+                                    None if u is None else np.asarray(u, float)[:nut],
+                                    None if ud is None else np.asarray(ud, float)[:nut], t)
+
+    def _padded(self, J):
+        out = np.zeros((3, self.nu))
+        out[:, :J.shape[1]] = J
+        return out
+
+    def jacobian_rotation(self, q, frame, t=0.0):
+        return self._padded(self.tree.jacobian_rotation(np.asarray(q, float)[:self.tree.nq],
+                                                        frame, t))
+
+    def jacobian_translation(self, q, frame, point=None, t=0.0):
+        return self._padded(self.tree.jacobian_translation(
+            np.asarray(q, float)[:self.tree.nq], frame, point, t))
+
+    def point_positions(self, q, points, t=0.0):
+        return self.tree.point_positions(np.asarray(q, float)[:self.tree.nq], points, t)
+
+    def element_power(self, q, u, t=0.0):
+        """The force elements' ``(V, P_nc, P_actuators)``, the flexible bodies' modal
+        damping and geometric stiffening counted in ``P_nc`` (``modal_power``)."""
+        V, P_nc, P_act = self.tree.element_power(np.asarray(q, float)[:self.tree.nq],
+                                                 np.asarray(u, float)[:self.tree.nu], t)
+        return V, P_nc + flex.modal_power(self, q, u, t), P_act
+
+    def u_vector(self, values=None):
+        """As ``Model.u_vector``; a modal coordinate's name stands for its rate too."""
+        if isinstance(values, dict):
+            rates = {c: s for r in self.flexible.values()
+                     for c, s in zip(r.coordinates, r.speeds)}
+            values = {rates.get(k, k): v for k, v in values.items()}
+        return Model.u_vector(self, values)
+
+    def element_energy(self, q, u, t=0.0):
+        V, P_nc, P_act = self.element_power(q, u, t)
+        return V, P_nc + P_act
+
+    def load_power(self, q, u, t=0.0):
+        return self.tree.load_power(np.asarray(q, float)[:self.tree.nq],
+                                    np.asarray(u, float)[:self.tree.nu], t)
+
+    forward_dynamics = flex.forward_dynamics
+    state_derivative = flex.state_derivative
+    coordinate_rates = flex.coordinate_rates
+    mass_matrix = flex.mass_matrix
+    forcing = flex.forcing
+    energy = flex.energy
+    momentum = flex.momentum
+    mass_matrix_condition = flex.mass_matrix_condition
+    _check_at_rest = flex.check_at_rest
+
+    newton_euler = _not_yet("newton_euler")
+    reactions = _not_yet("reactions")
+    inverse_dynamics = _not_yet("inverse_dynamics")
+    inverse_dynamics_along = _not_yet("inverse_dynamics_along")
+    drive_efforts = _not_yet("drive_efforts (the energy balance of a driven model)")
+    lowlevel = _not_yet("the low-level compiled entry")
+    loop_arguments = _not_yet("the compiled loops")
