@@ -126,11 +126,27 @@ def _model_files():
     return sorted(MODELS.glob("*.toml")) if MODELS.is_dir() else []
 
 
+def _closed_form(el):
+    from mbdyn.elements.tables import Table
+    p = el.params
+    if el.kind == "shape-contact":
+        return False
+    if el.kind == "actuator":
+        return not (p["type"] in ("pid", "held") or p.get("gravity_compensation")
+                    or any(isinstance(p.get(k), Table) for k in ("value", "setpoint",
+                                                                 "command")))
+    return True
+
+
 @pytest.mark.parametrize("path", _model_files(), ids=lambda p: p.stem)
 def test_every_model_file_agrees_with_the_engine(path):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        model = mb.load_model(path).model
+        scene = mb.load_model(path)
+    # what has no closed form (contact between shapes; PIDs, gravity compensation and
+    # tables of actuators) is refused by the symbolic layer: the rest must agree
+    off = [el.name for el in scene.model._force_elements if not _closed_form(el)]
+    model = scene.system.compile(effects=[f"-{n}" for n in off]) if off else scene.model
     quaternions = any(j.kind in ("spherical", "free") for j in model.elements[1])
     states = random_states(model, 3)
     methods = ("jourdain", "newton-euler") if quaternions else ("jourdain", "newton-euler",

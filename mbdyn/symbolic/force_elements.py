@@ -245,3 +245,19 @@ def actuator(walk, el):
         lim = exact(p["limit"])
         tau = sympy.Min(sympy.Max(tau, -lim), lim)
     joint_effort(walk, el, joint, tau)
+
+
+def reflected_inertia(model, body):
+    """The rotor inertia of the motors whose joint's child is ``body``, seen through their
+    gears, ``gear^2 J a a^T`` about the joint axis ``a`` (child axes): what
+    ``compiled.actuator_packing.reflect_rotors`` adds to the numeric inertia."""
+    out = sympy.zeros(3, 3)
+    for el in getattr(model, "_force_elements", ()):
+        p = el.params
+        if el.kind != "actuator" or not p.get("rotor_inertia"):
+            continue
+        joint = model._joint[p["joint"]]
+        if joint.child == body:
+            a = sympy.Matrix([exact(x) for x in joint.axis])
+            out += exact(p["gear"]) ** 2 * exact(p["rotor_inertia"]) * (a * a.T)
+    return out

@@ -32,7 +32,7 @@ import numpy as np
 import sympy
 
 from ..errors import ModelError
-from .force_elements import apply_forces
+from .force_elements import apply_forces, reflected_inertia
 from .frames import (FrameMotion, _cross_columns, _joint_values, joint_motion,
                      quaternion_rates)
 from .simplify import (compact, compact_matrix, diff, free_symbols, replace_shared,
@@ -178,7 +178,7 @@ class Walk:
                 inertia = E3 * canonical(sympy.sympify(raw), table)
             else:
                 inertia = exact_matrix(arr, table)
-        return mass, com, inertia
+        return mass, com, inertia + reflected_inertia(self.model, body.name)
 
     def _joint_geometry(self, joint):
         table = self.sym.table
