@@ -16,7 +16,7 @@ from .. import files
 from ..errors import ModelError
 from ..escape import mathtext
 from .drawing import PLANE
-from .geometry import bounds, frames, sample_times, up_rotation
+from .geometry import bounds, frames, prepare, sample_times, up_rotation
 from .meshes import shade
 
 FORMATS = (".gif", ".mp4", ".html")
@@ -49,15 +49,16 @@ def animate(result, out, speed=1.0, fps=30.0, title=None, max_frames=MAX_FRAMES)
         # a GIF stores frame durations in whole centiseconds: make them exact
         fps = 100.0 / max(1, round(100.0 / fps))
     times = sample_times(result, fps, speed, max_frames)
-    scenes = frames(result, times)
     title = title or result.model.name
+    if ext == ".html":
+        from .html import plotly_js, write_html
+        plotly_js()                       # the missing extra named before any work
     with files.replacing(out) as tmp:     # a link at ``out`` is replaced, not followed
         if ext == ".html":
-            from .html import write_html
-            write_html(result.model, scenes, tmp, fps=fps, speed=speed, title=title)
+            write_html(prepare(result, times), tmp, fps=fps, speed=speed, title=title)
         else:
-            _write_movie(result.model, scenes, tmp, ext, fps, speed, title)
-    return len(scenes)
+            _write_movie(result.model, frames(result, times), tmp, ext, fps, speed, title)
+    return len(times)
 
 
 def snapshot(result, out, t=None, trail_frames=300, title=None):
