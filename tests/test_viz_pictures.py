@@ -157,3 +157,30 @@ def test_html_view_lays_out_without_clipping(ten_second_page, size, tmp_path):
     with Image.open(tmp_path / f"view_{w}x{h}.png") as im:
         colours = im.convert("RGB").getcolors(maxcolors=1 << 20)
     assert colours is not None and len(colours) > 20              # not a blank page
+
+
+# ---------------------------------------------------------------- plots by unit and scale
+def test_group_series_splits_units_and_scales():
+    from mbdyn.viz.plots import group_series
+    t = np.linspace(0, 1, 50)
+    table = {"a": (np.sin(t), "rad", ""), "x": (0.01 * t, "m", ""), "b": (3 * t, "rad", ""),
+             "y": (2.0 * t, "m", ""), "z": (np.zeros(50), "m", ""),
+             "v": (t, "m/s", ""), "w": (0.1 * t, "m", "")}
+    groups = group_series(table, ["a", "x", "b", "y", "z", "v", "w"])
+    assert groups == [("rad", ["a", "b"]), ("m", ["y", "z", "w"]), ("m", ["x"]),
+                      ("m/s", ["v"])]
+    # the chain of a group never spans more than the ratio
+    groups = group_series({k: (np.array([10.0 ** (k / 2)]), "J", "") for k in range(6)},
+                          list(range(6)), ratio=20)
+    assert [g for _, g in groups] == [[3, 4, 5], [0, 1, 2]]      # 316..31.6 and 10..1
+
+
+def test_plot_puts_signals_of_one_unit_but_other_scales_on_separate_axes(tmp_path):
+    res = _load("quarter_car.toml").simulate(t_end=1.0)   # potential ~2000 J, kinetic ~10 J
+    fig = res.plot(series="zw,zb,energy", out=tmp_path / "qc.png")
+    assert [ax.get_ylabel() for ax in fig.axes] == ["[m]", "[J]", "[J]"]
+    for ax in fig.axes:
+        peaks = [np.abs(ln.get_ydata()).max() for ln in ax.lines if ln.get_linestyle() == "-"]
+        assert max(peaks) <= 20 * min(peaks)
+    legend = [t.get_text() for t in fig.axes[1].get_legend().get_texts()]
+    assert "energy potential" in legend and "energy kinetic" not in legend
