@@ -7,7 +7,8 @@
 For each model: the page of a 10 s run at the default 30 frames per second, its size, and
 the time headless Chromium (Debian's ``chromium``, driven by Playwright, every request
 outside file:// blocked) takes from navigation to ``window.mbdynView`` being defined (the
-view drawn and ready to play): the median of three fresh browsers.  Screenshots at
+view drawn and ready to play): the median of three fresh browsers; and the same for a page
+holding only plotly.js and one empty 3D plot (the floor of any page made with plotly).  Screenshots at
 1280x800 and 1920x1080 are written beside the pages with ``--keep``.
 """
 import argparse
@@ -66,6 +67,15 @@ def main():
                 load_time(out, (w, h), folder / f"{stem}_{w}x{h}.png")
         print(f"| {label} ({result.t[-1]:.2f} s) | {n} | {out.stat().st_size / 1e6:.2f} MB "
               f"| {statistics.median(times):.2f} s |")
+    floor = folder / "plotly_alone.html"         # the floor: plotly.js and one empty 3D plot
+    from mbdyn.viz.html import plotly_js
+    floor.write_text("<!DOCTYPE html><html><head><meta charset='utf-8'><script>" + plotly_js()
+                     + "</script></head><body><div id='g' style='height:700px'></div><script>"
+                     "Plotly.newPlot('g',[{type:'scatter3d',x:[0,1],y:[0,1],z:[0,1]}])"
+                     ".then(function(){window.mbdynView={};});</script></body></html>")
+    times = [load_time(floor) for _ in range(3)]
+    print(f"| plotly.js alone, one empty 3D plot | - | {floor.stat().st_size / 1e6:.2f} MB "
+          f"| {statistics.median(times):.2f} s |")
 
 
 if __name__ == "__main__":
