@@ -51,8 +51,9 @@ def main():
                  "```sh", f"mbdyn animate models/{path.name}{case} --out {stem}.html",
                  "```", ""]
         print(f"{stem}: {time.perf_counter() - t0:.1f} s")
-    lines += ["", "The HTML views carry plotly.js (about 4.6 MB) inside; the rest is the "
-              "frames (30 per second of simulated time).", ""]
+    lines += ["", "The HTML views carry plotly.js (4.8 MB) inside; the rest is each solid's "
+              "mesh once and, per frame (30 per second of playback), every frame's pose "
+              "(docs/performance.md, \"The HTML view\").", ""]
     (ROOT / "docs" / "gallery.md").write_text("\n".join(lines + body))
 
 

@@ -102,13 +102,15 @@ def test_html_view_in_headless_chromium(pendulum_result, tmp_path):
     sync_playwright = _browser()
     out = tmp_path / "view.html"
     n = pendulum_result.animate(out)
-    assert out.stat().st_size < 8e6
+    assert out.stat().st_size < 5.2e6           # plotly.js (4.8 MB) and the poses
     text = out.read_text()
     import re
     assert not re.search(r"<script[^>]+src=", text)           # plotly.js is inside the file
     model = pendulum_result.model
     names = [g["name"] for g in model_geometry(model) if g["mass"] > 0]
     times = np.arange(n) / 30.0
+    from mbdyn.viz.geometry import prepare
+    half = prepare(pendulum_result, times).half
     with sync_playwright() as p:
         browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
         page = browser.new_page(viewport={"width": 900, "height": 700})
@@ -134,7 +136,8 @@ def test_html_view_in_headless_chromium(pendulum_result, tmp_path):
             q, u = state_at(pendulum_result, times[i])
             kin = model.kinematics(q, u, t=times[i])
             expected = np.array([kin.r_com[model.frame_index(nm)] for nm in names])
-            assert np.abs(drawn - expected).max() < 1e-9, i
+            # rounded to what a screen shows: 1e-4 of the scene's half-width
+            assert np.abs(drawn - expected).max() < 2e-4 * half, i
         shot = tmp_path / "view.png"
         page.screenshot(path=str(shot))
         browser.close()

@@ -579,12 +579,16 @@ def test_a_contact_is_an_effect_and_off_it_is_gone():
 
 
 def test_pictures_draw_the_contact_shapes_where_they_are():
-    from mbdyn.viz.contact_shapes import contact_lines
+    from mbdyn.viz.drawing import extra_primitives
+    from mbdyn.viz.meshes import primitive_mesh
     model, q = one_pair("plane", {}, "box", {"half_sizes": (0.1, 0.05, 0.02)},
                         ((0, 0, 0.3), None))
-    lines = contact_lines(model, model.kinematics(q, np.zeros(model.nu)))
-    assert len(lines) == 2 + 12                     # the plane's square and normal; 12 edges
-    box = np.vstack([pts for pts, _, _ in lines[2:]])
+    from mbdyn.viz.contact_shapes import ground_planes
+    prims = extra_primitives(model, model.kinematics(q, np.zeros(model.nu)))
+    assert [p[0] for p in prims] == ["box"]         # the ground's plane is a ground plane
+    (_, point, normal), = ground_planes(model)
+    assert normal == pytest.approx([0, 0, 1]) and point == pytest.approx([0, 0, 0])
+    box = primitive_mesh(*prims[0])[0]
     assert box.min(axis=0) == pytest.approx([-0.1, -0.05, 0.28])
     assert box.max(axis=0) == pytest.approx([0.1, 0.05, 0.32])
 

@@ -3,9 +3,10 @@ optional extra ``imageio-ffmpeg`` ships), or a self-contained HTML page (``viz.h
 
 Playback is real time by default (``speed`` > 1 plays faster); frames are sampled at
 ``fps`` per second of playback from the stored results (states interpolated between
-samples).  Bodies are drawn with their shapes (``viz.geometry``), centres of mass leave
-trails, the time is shown.  The world is turned so that "up" (against gravity) is drawn
-upwards.
+samples).  Bodies are drawn as shaded solids of their shapes, with the force elements,
+actuators and ground planes (``viz.geometry``, ``viz.drawing``); centres of mass leave
+trails, the time is shown.  The axes are the world's (x, y, z in metres, one scale), seen
+with the world axis nearest to "up" (against gravity) drawn upwards.
 """
 from __future__ import annotations
 
@@ -14,7 +15,9 @@ import numpy as np
 from .. import files
 from ..errors import ModelError
 from ..escape import mathtext
-from .geometry import bounds, frames, sample_times, up_rotation
+from .drawing import PLANE
+from .geometry import bounds, frames, prepare, sample_times, up_rotation
+from .meshes import shade
 
 FORMATS = (".gif", ".mp4", ".html")
 MAX_FRAMES = 3000
@@ -46,15 +49,16 @@ def animate(result, out, speed=1.0, fps=30.0, title=None, max_frames=MAX_FRAMES)
         # a GIF stores frame durations in whole centiseconds: make them exact
         fps = 100.0 / max(1, round(100.0 / fps))
     times = sample_times(result, fps, speed, max_frames)
-    scenes = frames(result, times)
     title = title or result.model.name
+    if ext == ".html":
+        from .html import plotly_js, write_html
+        plotly_js()                       # the missing extra named before any work
     with files.replacing(out) as tmp:     # a link at ``out`` is replaced, not followed
         if ext == ".html":
-            from .html import write_html
-            write_html(result.model, scenes, tmp, fps=fps, speed=speed, title=title)
+            write_html(prepare(result, times), tmp, fps=fps, speed=speed, title=title)
         else:
-            _write_movie(result.model, scenes, tmp, ext, fps, speed, title)
-    return len(scenes)
+            _write_movie(result.model, frames(result, times), tmp, ext, fps, speed, title)
+    return len(times)
 
 
 def snapshot(result, out, t=None, trail_frames=300, title=None):
@@ -74,34 +78,65 @@ def snapshot(result, out, t=None, trail_frames=300, title=None):
     plt.close(fig)
 
 
+def view_angles(model):
+    """``(vertical axis, elevation, azimuth, roll, light)``: the world axis nearest to "up"
+    (against gravity) drawn upwards, seen from a corner -- or, when it is y (the textbook's
+    planar models move in x-y), from the side of the x-y plane -- and the direction of a
+    light over the viewer's shoulder (world axes) for the solids' shading."""
+    up = up_rotation(model)[2]
+    k = int(np.argmax(np.abs(up)))
+    elev, azim = (15.0, 25.0) if k == 1 else (20.0, -60.0)
+    e, a = np.radians(elev), np.radians(azim)
+    eye = np.roll([np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)], k - 2)
+    light = eye + 0.9 * np.sign(up[k]) * np.eye(3)[k]
+    return "xyz"[k], elev, azim, (0.0 if up[k] > 0 else 180.0), light / np.linalg.norm(light)
+
+
+def _draw_solids(ax, scene, light):
+    from matplotlib.colors import to_rgb
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    for vertices, faces, colour in scene.solids:
+        shades = shade(to_rgb(colour), vertices, faces, light)
+        ax.add_collection3d(Poly3DCollection(vertices[faces], facecolors=shades,
+                                             edgecolors="none", linewidths=0))
+    for _, vertices, faces in scene.planes:
+        ax.add_collection3d(Poly3DCollection(vertices[faces], facecolors=PLANE, alpha=0.3,
+                                             edgecolors="none"))
+
+
 def _figure(model, scenes, title, speed):
-    """A 3D figure and ``draw(k)`` showing scene k, "up" drawn upwards."""
+    """A 3D figure in world axes (x, y, z in metres, equal scales, "up" drawn upwards) and
+    ``draw(k)`` showing scene k."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    Rv = up_rotation(model)
     centre, half = bounds(scenes)
-    c = Rv @ centre
+    vertical, elev, azim, roll, light = view_angles(model)
     fig = plt.figure(figsize=(5.5, 5.5))
     ax = fig.add_subplot(projection="3d")
-    ax.set_box_aspect((1, 1, 1))
 
     def draw(k):
         ax.cla()
         sc = scenes[k]
+        _draw_solids(ax, sc, light)
         for pts, colour, width in sc.lines:
-            p = pts @ Rv.T
-            ax.plot(p[:, 0], p[:, 1], p[:, 2], color=colour, lw=width)
+            ax.plot(pts[:, 0], pts[:, 1], pts[:, 2], color=colour, lw=width)
         for name, tr in sc.trails.items():
-            p = tr @ Rv.T
-            ax.plot(p[:, 0], p[:, 1], p[:, 2], color="0.6", lw=0.8)
-        for name, pos, colour, size in sc.markers:
-            p = Rv @ pos
-            ax.scatter([p[0]], [p[1]], [p[2]], color=colour, s=size ** 2, depthshade=False)
-        ax.set_xlim(c[0] - half, c[0] + half)
-        ax.set_ylim(c[1] - half, c[1] + half)
-        ax.set_zlim(c[2] - half, c[2] + half)
-        ax.set_xlabel("[m]")
+            ax.plot(tr[:, 0], tr[:, 1], tr[:, 2], color="0.6", lw=0.8)
+        for name, p, colour in sc.tags:
+            ax.scatter([p[0]], [p[1]], [p[2]], color=colour, marker="D", s=30,
+                       depthshade=False)
+        for name, p, colour, size in sc.markers:
+            ax.scatter([p[0]], [p[1]], [p[2]], color=colour, s=0.5 * size ** 2,
+                       depthshade=False, edgecolors="k", linewidths=0.4)
+        for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):
+            setter(c - half, c + half)
+        ax.set_box_aspect((1, 1, 1))
+        ax.view_init(elev=elev, azim=azim, roll=roll, vertical_axis=vertical)
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        ax.set_zlabel("z [m]")
+        ax.tick_params(labelsize=7)
         pace = f"  ({speed:g}x)" if speed != 1 else ""
         ax.set_title(f"{mathtext(title)}\nt = {sc.t:.3f} s{pace}", fontsize=9)
         return []

@@ -1,82 +1,49 @@
-"""What a picture of a model shows at one instant: polylines, markers and labels in world
-coordinates, from the bodies' shapes, or from what the model knows when a body has none.
+"""What a picture of a model shows at each instant, in world coordinates.
 
-Every body with mass is drawn as a sphere at its centre of mass, sized by its mass
-(relative to the heaviest body), and every joint as a line from the parent frame's origin
-to the child frame's origin and on to the child's centre of mass -- so every model draws
-without edits.  Each frame's axes are drawn at its origin (x red, y green, z blue).
-Shapes (``mbdyn.elements.bodies.make_shape``) are drawn as wireframes: a box by its
-edges, a cylinder or disk by its two rims and four lines, a sphere by three great circles,
-a rod as a thick line.  The joints that close loops are drawn in red, from each body's
-origin to the joint's point on it (``loop_lines``).
+Every body with mass gets a marker at its centre of mass, sized by its mass (relative to
+the heaviest body), and every joint a line from the parent frame's origin to the child
+frame's origin and on to the child's centre of mass -- so every model draws without edits.
+Each frame's axes are drawn at its origin (x red, y green, z blue).  Shapes
+(``mbdyn.elements.bodies.make_shape``) are shaded solids (``viz.meshes``); force elements,
+actuators, loop joints and ground planes as ``viz.drawing`` describes.  ``prepare`` poses
+every frame at the picture's instants once; ``frames`` realises them as ``Scene3D``s
+(matplotlib), ``viz.view_data`` sends the poses to the HTML view.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import ModelError
-from .contact_shapes import contact_lines
+from . import drawing as dr
+from .meshes import shape_mesh
 
-#: colours of a frame's x, y, z axes (red, green, blue)
-AXES = ("#e41a1c", "#4daf4a", "#377eb8")
 PALETTE = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
            "#7f7f7f", "#bcbd22", "#17becf")
 
 
 @dataclass
 class Scene3D:
-    """One instant: ``lines`` ``[(points (k, 3), colour, width)]``, ``markers``
-    ``[(name, position (3,), colour, size)]`` (one per body with mass: its centre of mass),
-    ``trails`` ``{name: points (m, 3)}``."""
+    """One instant in world axes: ``lines`` ``[(points (k, 3), colour, width)]``,
+    ``markers`` ``[(name, position (3,), colour, size)]`` (one per body with mass: its
+    centre of mass), ``trails`` ``{name: points (m, 3)}``, ``solids`` ``[(vertices,
+    faces, colour)]``, ``tags`` ``[(name, position, colour)]`` (bushings, bearings),
+    ``planes`` ``[(name, vertices, faces)]`` and the scene's ``extent`` (centre,
+    half-width) over the whole run."""
     t: float
     lines: list
     markers: list
     trails: dict
-
-
-def _circle(center, axis, radius, n=24):
-    a = np.asarray(axis, float)
-    helper = np.eye(3)[np.argmin(np.abs(a))]
-    e1 = np.cross(a, helper)
-    e1 /= np.linalg.norm(e1)
-    e2 = np.cross(a, e1)
-    s = np.linspace(0, 2 * np.pi, n + 1)
-    return center + radius * (np.outer(np.cos(s), e1) + np.outer(np.sin(s), e2))
-
-
-def shape_lines(shape, R, r):
-    """World polylines of a shape on a frame at ``r`` with rotation ``R``."""
-    to_world = lambda p: r + np.asarray(p) @ R.T  # noqa: E731
-    kind = shape["type"]
-    c = shape.get("center", np.zeros(3))
-    if kind == "rod":
-        return [to_world(np.array([shape["start"], shape["end"]]))]
-    if kind == "sphere":
-        rad = shape["radius"]
-        return [to_world(_circle(c, ax, rad)) for ax in np.eye(3)]
-    if kind == "box":
-        a, b, h = 0.5 * shape["size"]
-        corners = np.array([[sx * a, sy * b, sz * h] for sx in (-1, 1) for sy in (-1, 1)
-                            for sz in (-1, 1)]) + c
-        edges = [(0, 1), (2, 3), (4, 5), (6, 7), (0, 2), (1, 3), (4, 6), (5, 7), (0, 4),
-                 (1, 5), (2, 6), (3, 7)]
-        return [to_world(corners[[i, j]]) for i, j in edges]
-    # cylinder or disk: two rims and four generators
-    axis = shape["axis"]
-    half = 0.5 * shape["length"] * axis
-    top = _circle(c + half, axis, shape["radius"], 32)
-    bottom = _circle(c - half, axis, shape["radius"], 32)
-    out = [to_world(top), to_world(bottom)]
-    for k in range(0, 32, 8):
-        out.append(to_world(np.array([top[k], bottom[k]])))
-    return out
+    solids: list = field(default_factory=list)
+    tags: list = field(default_factory=list)
+    planes: list = field(default_factory=list)
+    extent: tuple = None
 
 
 def model_geometry(model):
-    """Static facts for drawing: per frame its shape (or None), colour, marker size, the
-    parent index and the joint position."""
+    """Static facts for drawing: per frame its shape (or None) and its mesh in body axes,
+    colour, marker size, the parent index and the joint position."""
     bodies, joints, _ = model.elements
     lengths = [np.linalg.norm(b.com) for b in bodies] + [np.linalg.norm(j.position)
                                                           for j in joints]
@@ -88,63 +55,81 @@ def model_geometry(model):
         colour = (b.shape or {}).get("color") or PALETTE[i % len(PALETTE)]
         size = 6 + 10 * np.cbrt(b.mass / biggest) if b.mass > 0 else 0
         out.append({"name": b.name, "shape": b.shape, "color": colour, "size": float(size),
-                    "com": b.com, "parent": int(model._parent[i]), "mass": b.mass,
-                    "attached": j.kind != "free", "triad": triad})
+                    "com": np.asarray(b.com, float), "parent": int(model._parent[i]),
+                    "mass": b.mass, "attached": j.kind != "free", "triad": triad,
+                    "mesh": shape_mesh(b.shape) if b.shape is not None else None})
     return out
 
 
-def instant(model, geometry, q, u, t):
-    """The ``Scene3D`` of the state ``(q, u)`` at ``t`` (trails left empty)."""
-    kin = model.kinematics(q, u, t=t)
-    lines, markers = [], []
-    for i, g in enumerate(geometry):
-        R, r = kin.R[i], kin.r[i]
-        p = g["parent"]
-        parent_origin = kin.r[p] if p >= 0 else np.zeros(3)
-        if g["shape"] is not None:
-            for pts in shape_lines(g["shape"], R, r):
-                lines.append((pts, g["color"], 2.0 if g["shape"]["type"] != "rod" else 4.0))
-        # the frame's axes (x red, y green, z blue) at its origin
-        for k in range(3):
-            lines.append((np.array([r, r + g["triad"] * R[:, k]]), AXES[k], 1.0))
-        # the links: parent origin -> joint (this origin) -> centre of mass (a free joint
-        # attaches nothing: no line to its parent)
-        if g["attached"]:
-            lines.append((np.array([parent_origin, r]), "#444444", 1.5))
-        lines.append((np.array([r, kin.r_com[i]]), "#444444", 1.5))
-        if g["mass"] > 0:
-            markers.append((g["name"], kin.r_com[i].copy(), g["color"], g["size"]))
-    if getattr(model, "has_loops", False):
-        lines.extend(loop_lines(model, kin))
-    lines.extend(contact_lines(model, kin))
-    return Scene3D(float(t), lines, markers, {})
+@dataclass
+class PosedRun:
+    """A run posed for pictures: ``poses`` ``[(t, R (m, 3, 3), r (m, 3))]`` of every
+    mover (the frames, then the extra primitives), the ``drawing``, the scene's ``centre``
+    and ``half``-width, and the output points' positions ``points`` ``{name: (n, 3)}``."""
+    model: object
+    geometry: list
+    drawing: dr.Drawing
+    poses: list
+    centre: np.ndarray
+    half: float
+    points: dict
 
 
-#: colour of the loop joints' links (the joints that close a loop)
-LOOP_COLOUR = "#d62728"
+def _posed(model, kin):
+    prims = dr.extra_primitives(model, kin)
+    R = np.concatenate([kin.R, np.array([p[1][0] for p in prims]).reshape(-1, 3, 3)])
+    r = np.concatenate([kin.r, np.array([p[1][1] for p in prims]).reshape(-1, 3)])
+    return R, r, prims
 
 
-def loop_lines(model, kin):
-    """Each loop joint drawn in red: a line from each body's frame origin to the joint's
-    point on it, and a distance constraint's rod between its two points (a coupling acts
-    on coordinates and is not drawn)."""
-    out = []
-    for name in model.loop_joints:
-        j = model.joint(name)
-        if j.kind == "coupling":
-            continue
-        points = []
-        for frame, s in ((j.parent, j.position), (j.child, j.child_position)):
-            if frame == "ground":
-                origin, point = np.zeros(3), np.asarray(s, float)
-            else:
-                i = model.frame_index(frame)
-                origin, point = kin.r[i], kin.r[i] + kin.R[i] @ s
-            out.append((np.array([origin, point]), LOOP_COLOUR, 2.5))
-            points.append(point)
-        if j.kind == "distance":
-            out.append((np.array(points), LOOP_COLOUR, 3.0))
-    return out
+def _extent(d, poses, extra):
+    """``(centre, half-width)`` of a cube holding every piece at every pose."""
+    pts = [extra.reshape(-1, 3)]
+    for _, R, r in poses:
+        pts += [r[m] + v @ R[m].T for m, v, _, _ in d.solids]
+        pts.append(np.array([dr.world(R, r, a) for _, _, ps in d.polylines for a in ps]
+                            + [dr.world(R, r, a) for _, a, b in d.springs + d.dampers
+                               for a in (a, b)]).reshape(-1, 3))
+    allp = np.vstack(pts) if pts else np.zeros((1, 3))
+    lo, hi = allp.min(axis=0), allp.max(axis=0)
+    return 0.5 * (lo + hi), max(0.5 * float((hi - lo).max()), 1e-3) * 1.1
+
+
+def prepare(result, times):
+    """Pose ``result`` at ``times``: a ``PosedRun``."""
+    model = result.model
+    geometry = model_geometry(model)
+    poses, first = [], None
+    for t in times:
+        q, u = state_at(result, t)
+        R, r, prims = _posed(model, model.kinematics(q, u, t=t))
+        first = prims if first is None else first
+        poses.append((float(t), R, r))
+    points = {name: np.array([[np.interp(t, result.t, arr[:, k]) for k in range(3)]
+                              for t in times]) for name, arr in (result.points or {}).items()}
+    extra = np.vstack(list(points.values())) if points else np.zeros((0, 3))
+    centre, half = _extent(dr.build(model, geometry, np.zeros(3), 1.0, first), poses, extra)
+    d = dr.build(model, geometry, centre, half, first)
+    for name, corners, _ in d.planes:         # a plane far from the motion stays in view
+        centre, half = _extent(d, [], np.vstack([extra, corners.mean(axis=0)[None],
+                                                 centre + half / 1.1, centre - half / 1.1]))
+    return PosedRun(model, geometry, d, poses, centre, half, points)
+
+
+def realise(d, t, R, r):
+    """The ``Scene3D`` of drawing ``d`` with the movers at ``R``, ``r`` (no trails)."""
+    lines = [(np.array([dr.world(R, r, a) for a in pts]), colour, width)
+             for colour, width, pts in d.polylines]
+    for _, a, b in d.springs:
+        lines.append((dr.coil(dr.world(R, r, a), dr.world(R, r, b), d.sizes["coil"]),
+                      dr.SPRING, 1.5))
+    for _, a, b in d.dampers:
+        body, rod = dr.damper(dr.world(R, r, a), dr.world(R, r, b))
+        lines += [(body, dr.DAMPER, 7.0), (rod, dr.DAMPER, 2.5)]
+    solids = [(r[m] + v @ R[m].T, f, colour) for m, v, f, colour in d.solids]
+    markers = [(name, dr.world(R, r, a), colour, size) for name, a, colour, size in d.markers]
+    tags = [(name, dr.world(R, r, a), colour) for name, a, colour in d.tags]
+    return Scene3D(float(t), lines, markers, {}, solids, tags, list(d.planes))
 
 
 def sample_times(result, fps=30.0, speed=1.0, max_frames=None):
@@ -185,36 +170,30 @@ def state_at(result, t):
 
 def frames(result, times, trail=90):
     """``Scene3D`` of every time in ``times``, with the trails of the centres of mass and of
-    the run's output points (``[outputs.points]``) over the
-    last ``trail`` frames (3 s of real-time playback: keeps an HTML view's size linear in
-    its length)."""
-    model = result.model
-    geometry = model_geometry(model)
-    out = []
-    trail_points, trail_length = {}, int(trail)
-    outputs = result.points or {}
-    for t in times:
-        q, u = state_at(result, t)
-        sc = instant(model, geometry, q, u, t)
+    the run's output points (``[outputs.points]``) over the last ``trail`` frames."""
+    run = prepare(result, times)
+    out, trail_points = [], {}
+    for k, (t, R, r) in enumerate(run.poses):
+        sc = realise(run.drawing, t, R, r)
+        sc.extent = (run.centre, run.half)
         for name, pos, _, _ in sc.markers:
             trail_points.setdefault(name, []).append(pos)
-        for name, arr in outputs.items():        # the run's output points leave trails too
-            pos = np.array([np.interp(t, result.t, arr[:, k]) for k in range(3)])
-            trail_points.setdefault("point " + name, []).append(pos)
-        sc.trails = {k: np.array(v[-trail_length:]) for k, v in trail_points.items()}
+        for name, arr in run.points.items():     # the run's output points leave trails too
+            trail_points.setdefault("point " + name, []).append(arr[k])
+        sc.trails = {n: np.array(v[-int(trail):]) for n, v in trail_points.items()}
         out.append(sc)
     return out
 
 
 def bounds(scenes):
-    """A cube that holds every line and marker of the scenes: ``(centre, half-width)``."""
+    """The cube that holds the scenes: ``(centre, half-width)``."""
+    if scenes and scenes[0].extent is not None:
+        return scenes[0].extent
     pts = [pts for sc in scenes for pts, _, _ in sc.lines]
     pts += [pos[None, :] for sc in scenes for _, pos, _, _ in sc.markers]
     allp = np.vstack(pts) if pts else np.zeros((1, 3))
     lo, hi = allp.min(axis=0), allp.max(axis=0)
-    centre = 0.5 * (lo + hi)
-    half = max(0.5 * float((hi - lo).max()), 1e-3) * 1.1
-    return centre, half
+    return 0.5 * (lo + hi), max(0.5 * float((hi - lo).max()), 1e-3) * 1.1
 
 
 def up_rotation(model):

@@ -4,7 +4,8 @@ Series are named as the columns of ``mbdyn run --out``'s CSV: a coordinate or sp
 (``theta1``, ``theta1_dot``), ``energy_kinetic`` ... ``energy_balance``,
 ``reaction_JOINT_Fx`` ... ``_Mz``, ``effort_JOINT``, ``point_NAME_x`` ...; a group's prefix
 (``energy``, ``reaction_JOINT``, ``point_NAME``) stands for all its columns.  Each series
-is labelled with its unit; series of one unit share an axis; event times are marked.
+is labelled with its unit; series share an axis when they have one unit and peaks within
+a factor of 20 of each other (``group_series``); event times are marked.
 """
 from __future__ import annotations
 
@@ -69,6 +70,37 @@ def series_table(result):
     return table
 
 
+#: signals of one unit whose largest magnitudes differ more than this share no axis
+SCALE_RATIO = 20.0
+
+
+def group_series(table, names, ratio=SCALE_RATIO):
+    """The axes of a time plot: ``[(unit, [names])]``, one group per unit (in the order the
+    units first appear), each split by magnitude so that within a group the largest peak
+    ``max |x|`` is at most ``ratio`` times the smallest (signals that stay zero join the
+    first group of their unit)."""
+    by_unit = {}
+    for n in names:
+        by_unit.setdefault(table[n][1], []).append(n)
+    out = []
+    for unit, group in by_unit.items():
+        peak = {n: float(np.nanmax(np.abs(table[n][0]))) if len(table[n][0]) else 0.0
+                for n in group}
+        peak = {n: (p if np.isfinite(p) else 0.0) for n, p in peak.items()}
+        zero = [n for n in group if peak[n] == 0.0]
+        split = []
+        for n in sorted((n for n in group if peak[n] > 0.0), key=lambda n: -peak[n]):
+            if split and peak[split[-1][0]] <= ratio * peak[n]:
+                split[-1].append(n)
+            else:
+                split.append([n])
+        split = split or [[]]
+        split[0] += zero
+        order = {n: k for k, n in enumerate(group)}           # the order asked for
+        out += [(unit, sorted(g, key=order.get)) for g in split]
+    return out
+
+
 def _names(value, what):
     """Series names from ``"a,b"`` or a list of names; anything else is refused."""
     if isinstance(value, str):
@@ -109,7 +141,8 @@ def _save(fig, path):
 
 def plot_result(result, series=None, phase=None, out=None, title=None):
     """Plot ``series`` (names or group prefixes; default: the coordinates, and the energy
-    balance when the result has one) against time, one axis per unit, event times marked;
+    balance when the result has one) against time, one axis per unit and scale
+    (``group_series``), event times marked;
     or, with ``phase=(X, Y)``, a phase portrait of two series.  Saves to ``out`` (.png, .pdf,
     .svg) when given; returns the matplotlib figure."""
     if out is not None:
@@ -148,12 +181,10 @@ def plot_result(result, series=None, phase=None, out=None, title=None):
         names = _expand(series, table)
         if not names:
             raise ModelError("nothing to plot: give series names")
-        by_unit = {}
-        for n in names:
-            by_unit.setdefault(table[n][1], []).append(n)
-        fig, axes = plt.subplots(len(by_unit), 1, sharex=True,
-                                 figsize=(7.5, 2.2 + 1.6 * len(by_unit)), squeeze=False)
-        for ax, (unit, group) in zip(axes[:, 0], by_unit.items()):
+        groups = group_series(table, names)
+        fig, axes = plt.subplots(len(groups), 1, sharex=True,
+                                 figsize=(7.5, 2.2 + 1.6 * len(groups)), squeeze=False)
+        for ax, (unit, group) in zip(axes[:, 0], groups):
             for n in group:
                 ax.plot(result.t, table[n][0], lw=1.2, label=legend_label(table[n][2]))
             ax.set_ylabel(f"[{unit}]")
