@@ -599,3 +599,50 @@ def test_info_describes_the_contact_and_its_event(capsys):
     out = capsys.readouterr().out
     assert "balls          shape-contact: every pair of s1, s2, s3, s4, s5 (sweep and prune)" in out
     assert "first_impact   gap of contact ['s1', 's2']  (falling)" in out
+
+
+def _resting_ball(floor_kind):
+    m, k, radius = 2.0, 1e6, 0.05
+    delta = (m * 9.81 / k) ** (2 / 3)               # Hertz: k delta^1.5 = m g
+    s = mb.System("rest", gravity=(0, 0, -9.81))
+    s.add_body("ball", mass=m, inertia=[1e-3] * 3)
+    s.add_joint("j", "free", parent="ground", child="ball")
+    if floor_kind == "shapes":
+        s.add_shape("b", "sphere", "ball", radius=radius)
+        s.add_shape("floor", "plane", "ground", normal="z")
+        s.add_contact("c", pairs=[("floor", "b")], stiffness=k)
+    else:
+        s.add_force("c", "contact", body="ball", radius=radius, stiffness=k)
+    model = s.compile()
+    q = model.default_coordinates()
+    q[2] = radius - delta
+    return model, q, m, delta
+
+
+@pytest.mark.parametrize("floor_kind", ["shapes", "floor"])
+def test_contact_forces_of_a_ball_at_rest_are_its_weight_at_its_lowest_point(floor_kind):
+    model, q, m, delta = _resting_ball(floor_kind)
+    f = model.contact_forces(q, np.zeros(model.nu))
+    assert f.shape == (1, 6)
+    # a pair of shapes touches midway through the overlap; the floor contact at the
+    # sphere's lowest point
+    depth = delta / 2 if floor_kind == "shapes" else delta
+    assert f[0, :3] == pytest.approx([0, 0, -depth], abs=1e-12)
+    assert f[0, 3:] == pytest.approx([0, 0, m * 9.81], rel=1e-12)
+    assert np.abs(model.forward_dynamics(q, np.zeros(model.nu))).max() < 1e-9
+
+
+def test_contact_forces_drawn_as_arrows_when_asked(tmp_path):
+    from mbdyn.viz.geometry import ARROW, prepare
+    from mbdyn.viz.view_data import view_data
+    model, q, m, delta = _resting_ball("shapes")
+    res = mb.simulate(model, 0.1, q0=q, t_eval=np.linspace(0, 0.1, 5))
+    run = prepare(res, res.t, contact_forces=True)
+    assert len(run.arrows) == 5 and all(a.shape == (1, 2, 3) for a in run.arrows)
+    lengths = [np.linalg.norm(a[0, 1] - a[0, 0]) for a in run.arrows]
+    assert max(lengths) == pytest.approx(ARROW * run.half)      # the peak force's length
+    assert len(view_data(run, "t", 1.0, 30, 10)["arrows"]) == 5
+    assert prepare(res, res.t).arrows == []                      # not asked: none
+    out = tmp_path / "rest.html"
+    res.animate(str(out), contact_forces=True)
+    assert "contact forces" in out.read_text()

@@ -84,3 +84,22 @@ def impact_durations(model):
             / math.gamma(0.5 + a)
         out.append((el.name, duration, m))
     return out
+
+
+def contact_forces(model, q, u, t=0.0, max_points=512):
+    """The touching points of every contact (between shapes, and of spheres and disks on
+    the floor) at the state ``(q, u, t)``: an array ``(k, 6)`` of the world point (for a
+    pair of shapes the middle of their overlap, for the floor contact the sphere's or
+    rim's deepest point) and the force (world components) on one of the two bodies: the
+    one that is not the ground, else the second shape's of the pair (the other gets the
+    opposite).  At most ``max_points``; empty when nothing touches."""
+    if not any(el.kind in ("contact", KIND) for el in model._force_elements):
+        return np.zeros((0, 6))
+    model._kinematics_kernel(q, u, t)
+    acc = np.zeros(kc.RECORDS + 6 * int(max_points))
+    from ..kernels import forces as kf
+    kf.force_elements(model._force_int, model._force_data, model._parent, model._axis,
+                      model._com, model._qfull, model._ufull, model._R, model._r, model._w,
+                      model._v, model._F, model._N, acc, model._scratch)
+    n = min(int(acc[3]), int(max_points))
+    return acc[kc.RECORDS:kc.RECORDS + 6 * n].reshape(n, 6).copy()

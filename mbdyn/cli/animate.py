@@ -32,6 +32,8 @@ def register(subparsers):
     p.add_argument("--speed", type=positive, default=1.0, help="playback speed (default 1: "
                                                             "real time)")
     p.add_argument("--fps", type=positive, default=30.0, help="frames per second (default 30)")
+    p.add_argument("--contact-forces", action="store_true",
+                   help="draw each contact's force as an arrow from its touching point")
     add_simulation_arguments(p)
 
 
@@ -45,6 +47,7 @@ def run(args):
     progress = Progress(scene.settings.get("t_end") or 0.0)
     result = scene.simulate(progress=progress)
     progress.close()
-    n = animate(result, out, speed=args.speed, fps=args.fps, title=title(scene))
+    n = animate(result, out, speed=args.speed, fps=args.fps, title=title(scene),
+                contact_forces=args.contact_forces)
     sys.stdout.write(f"wrote {out} ({n} frames, {os.path.getsize(out) / 1e6:.2f} MB)\n")
     return 0

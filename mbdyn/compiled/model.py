@@ -198,6 +198,7 @@ class Model:
     element_energy = energies.element_energy
     element_power = energies.element_power
     contact_gap = contacts.contact_gap
+    contact_forces = contacts.contact_forces
     load_power = energies.load_power
     euler_singularity = diagnosis.euler_singularity
     # closed loops (``algorithms.constrained``, ``algorithms.closure``)

@@ -45,6 +45,8 @@ HEADER = 10
 SREC = 20
 #: floats of scratch a contact element needs: this plus ``6`` per shape of a group
 CONTACT_WORK = 64
+#: where the records of touching points start in an ``acc`` long enough to hold them
+RECORDS = 4
 
 
 # ---------------------------------------------------------------- the force law
@@ -82,6 +84,27 @@ def _touch(ia, ib, p, n, dist, off, data, R, r, w, v, com, F, N, acc, want, t):
     if want:
         acc[0] += k_ * delta ** (ex + 1.0) / (ex + 1.0)
         acc[1] += P - elastic * vn
+        if ib < 0:                              # recorded on the body, not the ground
+            for q in range(3):
+                f[q] = -f[q]
+        record(acc, p, f)
+
+
+@njit(**UNCOUNTED)
+def record(acc, p, f):
+    """With ``acc`` longer than ``RECORDS``, the touching point ``p`` and the force ``f``
+    on its second body appended there (``acc[3]`` counts them; what does not fit is
+    counted, not stored): the contact forces the pictures draw
+    (``algorithms.contacts.contact_forces``)."""
+    if acc.shape[0] <= RECORDS:
+        return
+    k = int(acc[3])
+    at = RECORDS + 6 * k
+    if at + 6 <= acc.shape[0]:
+        for q in range(3):
+            acc[at + q] = p[q]
+            acc[at + 3 + q] = f[q]
+    acc[3] = k + 1
 
 
 @njit(**UNCOUNTED)

@@ -25,7 +25,7 @@ import math
 from numba import njit
 
 from .actuation import PROGRAM, PROGRAM_WORK, actuator_effort, program_value, stop_effort
-from .contact import CONTACT_SHAPES, shape_contacts
+from .contact import CONTACT_SHAPES, record, shape_contacts
 from .linalg3 import cross_to, mat_t_vec, mat_vec
 from .tables import LINEAR, NO_TABLE, PCHIP, table_eval  # noqa: F401
 from .views import UNCOUNTED
@@ -373,6 +373,7 @@ def _contact(kind, i, off, data, R, r, w, v, com, F, N, acc, want, pc, vc, n, f,
         f[q] = fn * n[q] + ft * lever[q]
     _apply(i, pc, f, zero, 1.0, R, r, com, F, N, lever, t)
     if want:
+        record(acc, pc, f)
         acc[0] += k_ * delta ** (ex + 1.0) / (ex + 1.0)
         P = 0.0
         for q in range(3):

@@ -37,9 +37,11 @@ def check_output(path):
     return ext
 
 
-def animate(result, out, speed=1.0, fps=30.0, title=None, max_frames=MAX_FRAMES):
+def animate(result, out, speed=1.0, fps=30.0, title=None, max_frames=MAX_FRAMES,
+            contact_forces=False):
     """Write an animation of ``result`` to ``out`` (.gif, .mp4 or .html); returns the
-    number of frames.  The file is written whole or not at all."""
+    number of frames.  ``contact_forces``: draw each contact's force as an arrow from its
+    touching point.  The file is written whole or not at all."""
     ext = check_output(out)
     for name, value in (("speed", speed), ("fps", fps)):
         if (isinstance(value, bool) or not isinstance(value, (int, float, np.number))
@@ -55,15 +57,18 @@ def animate(result, out, speed=1.0, fps=30.0, title=None, max_frames=MAX_FRAMES)
         plotly_js()                       # the missing extra named before any work
     with files.replacing(out) as tmp:     # a link at ``out`` is replaced, not followed
         if ext == ".html":
-            write_html(prepare(result, times), tmp, fps=fps, speed=speed, title=title)
+            write_html(prepare(result, times, contact_forces), tmp, fps=fps, speed=speed,
+                       title=title)
         else:
-            _write_movie(result.model, frames(result, times), tmp, ext, fps, speed, title)
+            _write_movie(result.model, frames(result, times, contact_forces=contact_forces),
+                         tmp, ext, fps, speed, title)
     return len(times)
 
 
-def snapshot(result, out, t=None, trail_frames=300, title=None):
+def snapshot(result, out, t=None, trail_frames=300, title=None, contact_forces=False):
     """A still picture (.png, .pdf, .svg) of the state at ``t`` (default the end), with the
-    centres of mass' trails up to then; written whole or not at all."""
+    centres of mass' trails up to then (and the contact forces as arrows when asked);
+    written whole or not at all."""
     from .plots import _check_path, _save
     _check_path(out)
     import matplotlib
@@ -71,7 +76,7 @@ def snapshot(result, out, t=None, trail_frames=300, title=None):
     import matplotlib.pyplot as plt
     t_end = float(result.t[-1] if t is None else t)
     times = np.linspace(float(result.t[0]), t_end, max(2, trail_frames))
-    scenes = frames(result, times, trail=trail_frames)
+    scenes = frames(result, times, trail=trail_frames, contact_forces=contact_forces)
     fig, draw = _figure(result.model, scenes, title or result.model.name, 1.0)
     draw(len(scenes) - 1)
     _save(fig, out)

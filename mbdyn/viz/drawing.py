@@ -32,6 +32,7 @@ ACTUATOR = "#ff7f0e"
 MOUNT = "#6a3d9a"
 PLANE = "#9a9a9a"
 PRIMITIVE = "#8c8c8c"
+FORCE = "#d62728"
 #: sizes in the scene's half-width: coil and damper radii, rings, a plane's half-width
 SIZES = {"coil": 0.035, "damper": 0.018, "ring": 0.07, "plane": 1.0}
 #: polyline widths (points) of the groups

@@ -65,7 +65,9 @@ def model_geometry(model):
 class PosedRun:
     """A run posed for pictures: ``poses`` ``[(t, R (m, 3, 3), r (m, 3))]`` of every
     mover (the frames, then the extra primitives), the ``drawing``, the scene's ``centre``
-    and ``half``-width, and the output points' positions ``points`` ``{name: (n, 3)}``."""
+    and ``half``-width, the output points' positions ``points`` ``{name: (n, 3)}`` and,
+    when asked, the contact forces as ``arrows``: per pose an array ``(k, 2, 3)`` of
+    segments from each touching point along its force (``Model.contact_forces``)."""
     model: object
     geometry: list
     drawing: dr.Drawing
@@ -73,6 +75,7 @@ class PosedRun:
     centre: np.ndarray
     half: float
     points: dict
+    arrows: list = field(default_factory=list)
 
 
 def _posed(model, kin):
@@ -95,16 +98,19 @@ def _extent(d, poses, extra):
     return 0.5 * (lo + hi), max(0.5 * float((hi - lo).max()), 1e-3) * 1.1
 
 
-def prepare(result, times):
-    """Pose ``result`` at ``times``: a ``PosedRun``."""
+def prepare(result, times, contact_forces=False):
+    """Pose ``result`` at ``times``: a ``PosedRun`` (with the contact forces' arrows when
+    ``contact_forces``)."""
     model = result.model
     geometry = model_geometry(model)
-    poses, first = [], None
+    poses, first, forces = [], None, []
     for t in times:
         q, u = state_at(result, t)
         R, r, prims = _posed(model, model.kinematics(q, u, t=t))
         first = prims if first is None else first
         poses.append((float(t), R, r))
+        if contact_forces:
+            forces.append(model.contact_forces(q, u, t))
     points = {name: np.array([[np.interp(t, result.t, arr[:, k]) for k in range(3)]
                               for t in times]) for name, arr in (result.points or {}).items()}
     extra = np.vstack(list(points.values())) if points else np.zeros((0, 3))
@@ -113,13 +119,27 @@ def prepare(result, times):
     for name, corners, _ in d.planes:         # a plane far from the motion stays in view
         centre, half = _extent(d, [], np.vstack([extra, corners.mean(axis=0)[None],
                                                  centre + half / 1.1, centre - half / 1.1]))
-    return PosedRun(model, geometry, d, poses, centre, half, points)
+    return PosedRun(model, geometry, d, poses, centre, half, points, arrows(forces, half))
 
 
-def realise(d, t, R, r):
-    """The ``Scene3D`` of drawing ``d`` with the movers at ``R``, ``r`` (no trails)."""
+#: the longest contact-force arrow, in the scene's half-width
+ARROW = 0.35
+
+
+def arrows(forces, half):
+    """Segments ``(k, 2, 3)`` per pose from each point along its force, the largest force
+    of the run drawn ``ARROW`` half-widths long."""
+    peak = max([np.linalg.norm(f[:, 3:], axis=1).max() for f in forces if len(f)] + [0.0])
+    scale = ARROW * half / peak if peak > 0 else 0.0
+    return [np.stack([f[:, :3], f[:, :3] + scale * f[:, 3:]], axis=1) for f in forces]
+
+
+def realise(d, t, R, r, arrows=()):
+    """The ``Scene3D`` of drawing ``d`` with the movers at ``R``, ``r`` and the contact
+    forces' ``arrows`` (segments; no trails)."""
     lines = [(np.array([dr.world(R, r, a) for a in pts]), colour, width)
              for colour, width, pts in d.polylines]
+    lines += [(seg, dr.FORCE, 2.5) for seg in arrows]
     for _, a, b in d.springs:
         lines.append((dr.coil(dr.world(R, r, a), dr.world(R, r, b), d.sizes["coil"]),
                       dr.SPRING, 1.5))
@@ -168,13 +188,14 @@ def state_at(result, t):
     return q, u
 
 
-def frames(result, times, trail=90):
+def frames(result, times, trail=90, contact_forces=False):
     """``Scene3D`` of every time in ``times``, with the trails of the centres of mass and of
-    the run's output points (``[outputs.points]``) over the last ``trail`` frames."""
-    run = prepare(result, times)
+    the run's output points (``[outputs.points]``) over the last ``trail`` frames, and the
+    contact forces as arrows when asked."""
+    run = prepare(result, times, contact_forces)
     out, trail_points = [], {}
     for k, (t, R, r) in enumerate(run.poses):
-        sc = realise(run.drawing, t, R, r)
+        sc = realise(run.drawing, t, R, r, run.arrows[k] if run.arrows else ())
         sc.extent = (run.centre, run.half)
         for name, pos, _, _ in sc.markers:
             trail_points.setdefault(name, []).append(pos)

@@ -113,6 +113,14 @@
     });
     return o;
   });
+  if (D.arrows.length) dynamicLine(line(D.colors.force, 4, "contact forces"), function (k) {
+    var o = xyz(), a = D.arrows[k];
+    for (var n = 0; n < a.length; n += 6) {
+      push(o, [a[n] * U, a[n + 1] * U, a[n + 2] * U]);
+      push(o, [a[n + 3] * U, a[n + 4] * U, a[n + 5] * U]); gap(o);
+    }
+    return o;
+  });
   if (D.tags.length) dynamicLine({type: "scatter3d", mode: "markers", name: "mounts",
     showlegend: false, text: D.tags.map(function (t) { return t.label; }),
     hovertemplate: "%{text}<extra></extra>", x: [], y: [], z: [],

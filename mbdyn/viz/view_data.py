@@ -76,7 +76,9 @@ def view_data(run, title, speed, fps, trail):
         "dampers": [[_at(a, unit), _at(b, unit)] for _, a, b in d.dampers],
         "tags": [{"at": _at(a, unit), "color": c, "label": markup(n)} for n, a, c in d.tags],
         "points": [_ints(arr, unit) for arr in run.points.values()],
+        "arrows": [_ints(a, unit) for a in run.arrows],
         "sizes": {k: round(v / unit) for k, v in d.sizes.items()},
-        "colors": {"spring": dr.SPRING, "damper": dr.DAMPER, "trail": "#aaaaaa"},
+        "colors": {"spring": dr.SPRING, "damper": dr.DAMPER, "trail": "#aaaaaa",
+                   "force": dr.FORCE},
         "centre": (run.centre / unit).round().tolist(), "half": round(run.half / unit),
     }
