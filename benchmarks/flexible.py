@@ -1,0 +1,85 @@
+#!/usr/bin/env python
+"""What a flexible body costs per evaluation (issue 26), against the number of modes and
+of beam elements, and against the same body rigid.
+
+    python benchmarks/flexible.py            # a table (about half a minute)
+
+A steel shaft (1 m, 20 mm) on a revolute joint of the ground, its frame at the root,
+spinning: medians (us) of ``Model.forward_dynamics`` at a random state.  The flexible
+terms are evaluated in Python (numpy) on top of the compiled tree (docs/flexible.md,
+"Routes and cost"); the rigid body is the compiled route.  The number of beam elements
+changes only the reduction (done once, at compile), not an evaluation: the table shows
+it.  Exudyn's ``ObjectFFRFreducedOrder`` is not compared here (see the issue's note).
+"""
+import os
+
+for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS"):
+    os.environ[_var] = "1"
+
+import gc  # noqa: E402
+import statistics  # noqa: E402
+import sys  # noqa: E402
+import warnings  # noqa: E402
+from pathlib import Path  # noqa: E402
+from time import perf_counter  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+import mbdyn as mb  # noqa: E402
+
+
+def per_call(fn, budget=0.05, rounds=11):
+    fn()
+    n = 1
+    while True:
+        t0 = perf_counter()
+        for _ in range(n):
+            fn()
+        if perf_counter() - t0 > budget / 4 or n > 1 << 18:
+            break
+        n *= 2
+    out = []
+    gc.disable()
+    try:
+        for _ in range(rounds):
+            t0 = perf_counter()
+            for _ in range(n):
+                fn()
+            out.append((perf_counter() - t0) / n * 1e6)
+    finally:
+        gc.enable()
+    return statistics.median(out)
+
+
+def shaft(modes, elements):
+    s = mb.System("shaft", gravity=(0, 0, -9.81))
+    beam = {"length": 1.0, "elements": elements, "E": 2.1e11, "rho": 7850.0, "nu": 0.3,
+            "section": {"circle": 0.02}}
+    s.add_body("shaft", flexible={"beam": beam, "modes": modes})
+    s.add_joint("spin", "revolute", parent="ground", child="shaft", axis="z")
+    return s
+
+
+def main():
+    warnings.simplefilter("ignore")
+    rng = np.random.default_rng(0)
+    rigid = shaft(2, 10).compile(effects="-flexibility_shaft")
+    q, u = rng.normal(size=rigid.nq), rng.normal(size=rigid.nu)
+    base = per_call(lambda: rigid.forward_dynamics(q, u))
+    t0 = perf_counter()
+    print("| modes | elements | us per forward_dynamics | ratio to the rigid body | "
+          "compile (s) |")
+    print("|---|---|---|---|---|")
+    print(f"| rigid | - | {base:.2f} | 1.0 | - |")
+    for modes, elements in ((2, 10), (4, 10), (8, 10), (4, 5), (4, 20), (4, 40)):
+        t0 = perf_counter()
+        m = shaft(modes, elements).compile()
+        build = perf_counter() - t0
+        q, u = rng.normal(size=m.nq) * 1e-3, rng.normal(size=m.nu) * 1e-3
+        c = per_call(lambda m=m, q=q, u=u: m.forward_dynamics(q, u))
+        print(f"| {modes} | {elements} | {c:.1f} | {c / base:.0f} | {build:.2f} |")
+
+
+if __name__ == "__main__":
+    main()
