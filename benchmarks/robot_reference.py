@@ -42,7 +42,7 @@ try:
 except ImportError:  # pragma: no cover - the generator's own environment
     sys.exit("this generator needs Pinocchio: pip install pin example-robot-data "
              "(in an environment of their own)")
-from urdf_reference import names_of, one_state, random_state  # noqa: E402
+from urdf_reference import names_of, one_state, random_state
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DATA = os.path.join(HERE, "..", "tests", "data")

@@ -13,6 +13,7 @@ found through ``$EXAMPLE_ROBOT_DATA`` (its ``robots/`` folder), the installed pa
 compared, not only quantities a convention leaves unchanged, so a wrong import convention
 (rpy order, axis or inertia frame, a fixed joint's placement) fails.
 """
+import contextlib
 import glob
 import json
 import os
@@ -38,12 +39,10 @@ def robots_folder():
     candidates = []
     if os.environ.get("EXAMPLE_ROBOT_DATA"):
         candidates.append(os.environ["EXAMPLE_ROBOT_DATA"])
-    try:
+    with contextlib.suppress(Exception):          # absent or broken: look elsewhere
         from example_robot_data import getModelPath
         candidates.append(os.path.join(getModelPath("ur_description/urdf/ur5_robot.urdf"),
                                        "robots"))
-    except Exception:  # noqa: BLE001 - absent or broken: look elsewhere
-        pass
     candidates += [os.path.join(entry, CMEEL) for entry in sys.path]
     candidates += glob.glob(os.path.join("/tmp/pinvenv/lib/python3*/site-packages", CMEEL))
     for folder in candidates:
