@@ -2,7 +2,8 @@
 """URDF robots: mbdyn against Pinocchio per call -- forward dynamics (``aba``), inverse
 dynamics (``rnea``), mass matrix (``crba``) -- and the time to load a URDF file.
 
-    python benchmarks/robots.py            # the robots of tests/data/
+    python benchmarks/robots.py            # the robots of tests/data/ (and of
+                                           # example-robot-data, when found)
     python benchmarks/robots.py --quick    # a shorter time budget
 
 Pinocchio is for benchmarking only, never a dependency of mbdyn: install it into an
@@ -37,7 +38,40 @@ import forward_dynamics as fdb  # noqa: E402  (this folder: the per-call timer)
 import numpy as np  # noqa: E402
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "data")
-ROBOTS = [("planar_arm", False), ("arm6", False), ("mixed", False), ("arm6", True)]
+# (label, URDF file, floating base, options of mbdyn's reading)
+ROBOTS = [(name, os.path.join(DATA, f"{name}.urdf"), floating, {})
+          for name, floating in [("planar_arm", False), ("arm6", False), ("mixed", False),
+                                 ("arm6", True)]]
+# example-robot-data's (as benchmarks/robot_reference.py reads them: Panda's <mimic>
+# removed, its fingers independent as in Pinocchio; TIAGo's antennas' inertia accepted)
+ERD_ROBOTS = [
+    ("ur5", "ur_description/urdf/ur5_robot.urdf", False, {}),
+    ("panda", "panda_description/urdf/panda.urdf", False, {"strip_mimic": True}),
+    ("solo12", "solo_description/robots/solo12.urdf", True, {}),
+    ("tiago", "tiago_description/robots/tiago_no_hand.urdf", False,
+     {"accept_inertia": True}),
+]
+
+
+def erd_folder():
+    """example-robot-data's ``robots/`` folder (``$EXAMPLE_ROBOT_DATA``, or its cmeel
+    prefix under a site folder on ``sys.path``), or None."""
+    if os.environ.get("EXAMPLE_ROBOT_DATA"):
+        return os.environ["EXAMPLE_ROBOT_DATA"]
+    for entry in sys.path:
+        folder = os.path.join(entry, "cmeel.prefix", "share", "example-robot-data", "robots")
+        if os.path.isdir(folder):
+            return folder
+    return None
+
+
+def robots():
+    folder = erd_folder()
+    if folder is None:
+        return ROBOTS
+    return ROBOTS + [(name, os.path.join(folder, rel), floating, options)
+                     for name, rel, floating, options in ERD_ROBOTS
+                     if os.path.isfile(os.path.join(folder, rel))]
 
 
 def load_time(fn, rounds=20):
@@ -67,14 +101,23 @@ def pin_state(pmodel, model, q, u):
     return qp, vp
 
 
-def robot_rows(name, floating, budget, repeats):
+def robot_rows(path, floating, options, budget, repeats):
+    import re
+
     import pinocchio as pin
 
     import mbdyn as mb
-    path = os.path.join(DATA, f"{name}.urdf")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        scene = mb.load_model(path, floating=floating)
+    with open(path) as fh:
+        text = fh.read()
+    if options.get("strip_mimic"):
+        text = re.sub(r"<mimic\b[^>]*/>", "", text)
+    accept = options.get("accept_inertia", False)
+
+    def read():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return mb.load_model(path, text=text, floating=floating, accept_inertia=accept)
+    scene = read()
     model = scene.system.compile(effects=[f"-{n}" for n in scene.system.forces])
     pmodel = (pin.buildModelFromUrdf(path, pin.JointModelFreeFlyer()) if floating
               else pin.buildModelFromUrdf(path))
@@ -121,11 +164,7 @@ def robot_rows(name, floating, budget, repeats):
     })
     stats, ratio = fdb.measure(cases, budget, repeats, ratios)
 
-    def loading():
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            mb.load_model(path, floating=floating)
-    load = (load_time(loading), load_time(lambda: pin.buildModelFromUrdf(path)))
+    load = (load_time(read), load_time(lambda: pin.buildModelFromUrdf(path)))
     return model.nu, stats, ratio, load
 
 
@@ -139,8 +178,8 @@ def main():
           "load mbdyn / Pinocchio (ms) |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     reaction_rows = []
-    for name, floating in ROBOTS:
-        nu, st, ratio, load = robot_rows(name, floating, budget, repeats)
+    for name, path, floating, options in robots():
+        nu, st, ratio, load = robot_rows(path, floating, options, budget, repeats)
         reaction_rows.append((name, floating, nu, st, ratio))
 
         def us(key, against=None):
