@@ -53,6 +53,13 @@ MAX_SWEEP_MEMBERS = 1_000_000
 #: table is ~250 kB; a longer line is not a table mbdyn wrote)
 MAX_TABLE_LINE = 1_000_000
 
+#: bytes of one mesh file a picture reads (a URDF ``<visual>`` mesh; the UR5's largest
+#: DAE is ~2 MB, a finely scanned part ~30 MB); a larger one is left out, with a warning
+MAX_MESH_FILE_BYTES = 50_000_000
+#: triangles of one mesh in the pictures: a finer one is decimated (vertex clustering,
+#: ``viz.mesh_files.decimate``); the HTML page carries every mesh once at ~25 bytes a
+#: triangle, and matplotlib draws each triangle as a polygon every frame
+MAX_MESH_TRIANGLES = 3000
 
 
 def max_file_bytes():

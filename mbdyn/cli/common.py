@@ -83,13 +83,23 @@ def add_urdf_arguments(parser):
     parser.add_argument("--accept-inertia", action="store_true",
                         help="URDF: accept inertias no body can have (a negative principal "
                              "moment set to 0, a broken triangle inequality), with a warning")
+    parser.add_argument("--mesh-path", metavar="DIR", action="append", default=[],
+                        help="URDF: a folder where package:// meshes of <visual> are looked "
+                             "for, drawn by animate (repeatable; before the URDF's own "
+                             "folder and its parents)")
 
 
 def urdf_overrides(args):
-    """``(path, value, origin)`` of ``--floating`` and ``--accept-inertia``, if given."""
-    return [(f"model.{key}", True, flag) for key, flag in
-            (("floating", "--floating"), ("accept_inertia", "--accept-inertia"))
-            if getattr(args, key, False)]
+    """``(path, value, origin)`` of ``--floating``, ``--accept-inertia`` and
+    ``--mesh-path``, if given."""
+    out = [(f"model.{key}", True, flag) for key, flag in
+           (("floating", "--floating"), ("accept_inertia", "--accept-inertia"))
+           if getattr(args, key, False)]
+    folders = getattr(args, "mesh_path", None)
+    if folders:
+        out.append(("model.mesh_path", [os.path.abspath(f) for f in folders],
+                    "--mesh-path " + " ".join(folders)))
+    return out
 
 
 #: the simulation options of every command that runs a model (run, plot, animate, sweep,

@@ -25,7 +25,8 @@ class Body:
     com: np.ndarray = field(default_factory=lambda: np.zeros(3))
     inertia: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
     symbolic: dict = field(default_factory=dict)
-    shape: dict | None = None       # how pictures draw it (see make_shape)
+    shape: dict | tuple | None = None   # how pictures draw it: one shape or several
+                                        # (see make_shape)
 
     @property
     def has_inertia(self):
@@ -33,17 +34,31 @@ class Body:
 
 
 SHAPES = {"sphere": ("radius",), "box": ("size",), "cylinder": ("radius", "length"),
-          "disk": ("radius", "length"), "rod": ("start", "end")}
+          "disk": ("radius", "length"), "rod": ("start", "end"), "mesh": ("file",)}
+
+
+def shapes_of(body):
+    """The drawing shapes of ``body`` as a list (none, one or several)."""
+    shape = body.shape
+    return [] if shape is None else list(shape) if isinstance(shape, tuple) else [shape]
 
 
 def make_shape(shape, element, parameters=None):
     """A validated drawing shape in body axes: ``{"type": "sphere", "radius": r}``,
     ``{"type": "box", "size": [a, b, c]}``, ``{"type": "cylinder"|"disk", "radius": r,
-    "length": l, "axis": "z"}``, ``{"type": "rod", "start": [...], "end": [...]}``; each
-    with optional ``center`` (default the origin; a rod has none), ``radius`` of a rod
-    (its thickness) and ``color`` (a matplotlib/CSS colour name or "#rrggbb")."""
+    "length": l, "axis": "z"}``, ``{"type": "rod", "start": [...], "end": [...]}``,
+    ``{"type": "mesh", "file": path, "scale": [sx, sy, sz]}`` (a triangle-mesh file the
+    pictures read, ``mbdyn.viz.mesh_files``); each with optional ``center`` (default the
+    origin; a rod has none), ``rotation`` (a 3x3 rotation matrix: the shape's axes in body
+    axes, applied about ``center``), ``radius`` of a rod (its thickness) and ``color`` (a
+    matplotlib/CSS colour name or "#rrggbb").  A list of such tables is several shapes
+    (a tuple of them)."""
     if shape is None:
         return None
+    if isinstance(shape, (list, tuple)):
+        if not shape:
+            return None
+        return tuple(make_shape(s, element, parameters) for s in shape)
     if not isinstance(shape, dict) or "type" not in shape:
         raise ModelError(f"{element}: shape must be a table with a type, e.g. "
                          "{type = \"sphere\", radius = 0.02}")
@@ -51,7 +66,9 @@ def make_shape(shape, element, parameters=None):
     if kind not in SHAPES:
         raise ModelError(f"{element}: shape type {kind!r} is not one of "
                          f"{', '.join(SHAPES)}")
-    known = set(SHAPES[kind]) | {"type", "center", "color", "axis", "radius"}
+    known = set(SHAPES[kind]) | {"type", "center", "color", "axis", "radius", "rotation"}
+    if kind == "mesh":
+        known.add("scale")
     extra = sorted(set(shape) - known)
     if extra:
         raise ModelError(f"{element}: unknown shape key(s) {', '.join(extra)} for a {kind}; "
@@ -82,9 +99,35 @@ def make_shape(shape, element, parameters=None):
     if kind == "box" and np.any(out["size"] <= 0):
         raise ModelError(f"{element}: box size must be three positive lengths")
     out.setdefault("center", np.zeros(3))
+    if kind == "mesh":
+        _mesh_keys(shape, out, element)
+    if "rotation" in shape:
+        out["rotation"] = _rotation(shape["rotation"], element)
     if kind in ("cylinder", "disk"):
         out["axis"] = parse_axis(shape.get("axis", "z"), element)
     return out
+
+
+def _mesh_keys(shape, out, element):
+    """A mesh's ``file`` (a non-empty path) and ``scale`` (three non-zero numbers)."""
+    if not isinstance(shape["file"], str) or not shape["file"].strip():
+        raise ModelError(f"{element}: a mesh shape's file must be the path of a mesh file")
+    out["file"] = shape["file"]
+    scale = np.asarray(shape.get("scale", (1.0, 1.0, 1.0)), dtype=float).reshape(-1)
+    if scale.shape != (3,) or not np.all(np.isfinite(scale)) or np.any(scale == 0):
+        raise ModelError(f"{element}: a mesh's scale must be three non-zero numbers")
+    out["scale"] = scale
+
+
+def _rotation(value, element):
+    try:
+        R = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        R = np.zeros(0)
+    if R.shape != (3, 3) or not np.all(np.isfinite(R)) or \
+            np.abs(R @ R.T - np.eye(3)).max() > 1e-6 or np.linalg.det(R) < 0:
+        raise ModelError(f"{element}: a shape's rotation must be a 3x3 rotation matrix")
+    return R
 
 
 def make_body(name, mass=0.0, com=(0, 0, 0), inertia=None, parameters=None, shape=None):

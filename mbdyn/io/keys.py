@@ -4,11 +4,12 @@ of each key (``mbdyn.io.value_checks`` checks a value of each kind).
 from __future__ import annotations
 
 # value kinds: "string", "name", "expr", "vector", "axis", "inertia", "orientation",
-# "names", "bool", "condition", "direction", "reactions", "pairs", ("choice", options)
+# "names", "paths", "bool", "condition", "direction", "reactions", "pairs", ("choice", options)
 MODEL_KEYS = {"name": "string", "description": "string", "gravity": "vector",
               "default_case": "string",
               # a URDF robot the file includes (docs/urdf.md)
-              "urdf": "string", "floating": "bool", "accept_inertia": "bool"}
+              "urdf": "string", "floating": "bool", "accept_inertia": "bool",
+              "mesh_path": "paths"}
 BODY_KEYS = {"name": "name", "mass": "expr", "com": "vector", "inertia": "inertia",
              "inertia_about": ("choice", ("com", "origin")), "shape": "shape",
              # a modally reduced flexible body (docs/flexible.md)

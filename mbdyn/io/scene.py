@@ -55,7 +55,7 @@ def _normalise_overrides(overrides):
 
 
 def load_model(path, case=None, overrides=None, effects=None, *, text=None, floating=None,
-               accept_inertia=None):
+               accept_inertia=None, mesh_path=None):
     """Read a model file (TOML, or a URDF robot: ``.urdf``) and return a ready-to-run
     ``Scene``.
 
@@ -69,7 +69,8 @@ def load_model(path, case=None, overrides=None, effects=None, *, text=None, floa
     carries its model's text, not a file); ``path`` then only names it.  ``floating``,
     ``accept_inertia``: a URDF robot's base hangs from the ground by a free joint ``root``;
     inertias no body can have are accepted (``[model] floating``, ``accept_inertia``;
-    docs/urdf.md).  Raises ``ModelFileError`` (a ``ModelError``) naming file and key.
+    docs/urdf.md).  ``mesh_path``: a folder or a list of folders where a URDF's
+    ``package://`` meshes are looked for (``[model] mesh_path``).  Raises ``ModelFileError`` (a ``ModelError``) naming file and key.
     """
     if not isinstance(path, (str, os.PathLike)):
         raise ModelError(f"load_model: path must be the path of a .toml or .urdf file, got {path!r}")
@@ -89,6 +90,10 @@ def load_model(path, case=None, overrides=None, effects=None, *, text=None, floa
         (f"model.{key}", bool(value), f"{key}={bool(value)}")
         for key, value in (("floating", floating), ("accept_inertia", accept_inertia))
         if value is not None]
+    if mesh_path is not None:
+        folders = [mesh_path] if isinstance(mesh_path, (str, os.PathLike)) else mesh_path
+        overrides.append(("model.mesh_path", [os.path.abspath(os.fspath(f))
+                                              for f in folders], "mesh_path"))
     checker = Checker(path)
     checker.check_document(doc)
     default_case = doc.get("model", {}).get("default_case")

@@ -23,6 +23,14 @@ def _string(c, value, path):
         raise c.error(path, f"must be a string, got {kind_of(value)} {show(value)}")
 
 
+def _paths(c, value, path):
+    items = [value] if isinstance(value, str) else value
+    if not isinstance(items, list) or not all(isinstance(p, str) and p.strip()
+                                              for p in items):
+        raise c.error(path, f"must be a folder or an array of folders (strings), got "
+                      f"{kind_of(value)} {show(value)}")
+
+
 def _name(c, value, path):
     problem = identifier_problem(value)
     if problem:
@@ -227,7 +235,7 @@ def _flexible(c, value, path):
 #: kind -> its check
 CHECKS = {"string": _string, "name": _name, "bool": _boolean, "expr": _expression,
           "vector": _vector, "axis": _axis, "inertia": _inertia, "orientation": _orientation,
-          "names": _names, "condition": _condition, "direction": _direction,
+          "names": _names, "paths": _paths, "condition": _condition, "direction": _direction,
           "reactions": _reactions, "shape": _shape, "exprs": _expressions,
           "coefficient": _coefficient, "matrix6": _matrix6, "table": _table,
           "points": _points, "signal": _signal, "pairs": _pairs, "flexible": _flexible}

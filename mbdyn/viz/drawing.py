@@ -126,8 +126,8 @@ def build(model, geometry, centre, half, primitives=()):
     ``primitives`` are the extra primitives of the first instant."""
     d = Drawing(sizes={k: v * half for k, v in SIZES.items()})
     for i, g in enumerate(geometry):
-        if g["mesh"] is not None:
-            d.solids.append((i, *g["mesh"], g["color"]))
+        for vertices, faces, colour in g["meshes"]:
+            d.solids.append((i, vertices, faces, colour))
         for k in range(3):
             d.polylines.append((AXES[k], WIDTHS["axis"], [(i, np.zeros(3)),
                                                           (i, g["triad"] * np.eye(3)[k])]))

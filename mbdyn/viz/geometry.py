@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..elements.bodies import shapes_of
 from ..errors import ModelError
 from . import drawing as dr
 from .meshes import shape_mesh
@@ -42,8 +43,9 @@ class Scene3D:
 
 
 def model_geometry(model):
-    """Static facts for drawing: per frame its shape (or None) and its mesh in body axes,
-    colour, marker size, the parent index and the joint position."""
+    """Static facts for drawing: per frame its shape(s) (or None) and their ``meshes``
+    ``[(vertices, faces, colour)]`` in body axes (a mesh file that cannot be read left
+    out), colour, marker size, the parent index and the joint position."""
     bodies, joints, _ = model.elements
     lengths = [np.linalg.norm(b.com) for b in bodies] + [np.linalg.norm(j.position)
                                                           for j in joints]
@@ -52,12 +54,16 @@ def model_geometry(model):
     biggest = masses.max() if masses.size and masses.max() > 0 else 1.0
     out = []
     for i, (b, j) in enumerate(zip(bodies, joints)):
-        colour = (b.shape or {}).get("color") or PALETTE[i % len(PALETTE)]
+        shapes = shapes_of(b)
+        own = PALETTE[i % len(PALETTE)]
+        colour = next((s["color"] for s in shapes if s.get("color")), None) or own
         size = 6 + 10 * np.cbrt(b.mass / biggest) if b.mass > 0 else 0
+        meshes = [(*m, s.get("color") or own) for s in shapes
+                  for m in [shape_mesh(s)] if m is not None]
         out.append({"name": b.name, "shape": b.shape, "color": colour, "size": float(size),
                     "com": np.asarray(b.com, float), "parent": int(model._parent[i]),
                     "mass": b.mass, "attached": j.kind != "free", "triad": triad,
-                    "mesh": shape_mesh(b.shape) if b.shape is not None else None})
+                    "meshes": meshes})
     return out
 
 

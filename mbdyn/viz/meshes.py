@@ -83,9 +83,32 @@ def rod_radius(shape):
 
 
 def shape_mesh(shape):
-    """The mesh of a body's drawing shape in body axes."""
-    kind = shape["type"]
+    """The mesh of a body's drawing shape in body axes (``None`` for a mesh file that
+    cannot be read: ``viz.mesh_files`` warns once per file)."""
     c = np.asarray(shape.get("center", np.zeros(3)), float)
+    if "rotation" in shape or shape["type"] == "mesh":
+        mesh = _local_mesh(shape)
+        if mesh is None:
+            return None
+        R = np.asarray(shape.get("rotation", np.eye(3)), float)
+        return c + mesh[0] @ R.T, mesh[1]
+    return _local_mesh(shape, c)
+
+
+def _local_mesh(shape, c=None):
+    """The mesh of ``shape`` centred on ``c`` (default the origin), before any rotation."""
+    c = np.zeros(3) if c is None else c
+    kind = shape["type"]
+    if kind == "mesh":
+        from .mesh_files import file_mesh
+        mesh = file_mesh(shape["file"])
+        if mesh is None:
+            return None
+        v, f = mesh
+        scale = np.asarray(shape.get("scale", np.ones(3)), float)
+        if np.prod(np.sign(scale)) < 0:           # a mirror: keep the faces outward
+            f = f[:, ::-1]
+        return v * scale, f
     if kind == "sphere":
         return sphere(c, shape["radius"])
     if kind == "box":

@@ -31,16 +31,18 @@ def read_urdf(path, text=None):
 
 
 def add_urdf(system, path, *, floating=False, accept_inertia=False, text=None,
-             warn=True):
+             warn=True, mesh_path=()):
     """Add the URDF file ``path`` to ``system`` (a ``mb.System``); returns the
     ``RobotBuilder``: ``report`` (what was read and made), ``warnings``, ``bodies`` and
     ``joints`` (the names added).  ``floating``: the base hangs from the ground by a free
     joint ``root`` (else a fixed one).  ``accept_inertia``: take inertias no body can have
     (a negative principal moment set to zero, a broken triangle inequality), with a
-    warning, instead of refusing them.  ``warn``: emit the warnings (``ModelWarning``)."""
+    warning, instead of refusing them.  ``warn``: emit the warnings (``ModelWarning``).
+    ``mesh_path``: folders ``package://`` meshes of ``<visual>`` are looked for in (before
+    the URDF's own folder and its parents; docs/urdf.md)."""
     robot = read_urdf(path, text)
     builder = add_robot(system, Reader(path), robot, floating=floating,
-                        accept_inertia=accept_inertia)
+                        accept_inertia=accept_inertia, mesh_path=mesh_path)
     if warn:
         for message in builder.warnings:
             warnings.warn(message, ModelWarning, stacklevel=2)

@@ -17,7 +17,9 @@
   ``<dynamics friction>`` -> one with the law ``friction tanh(v / 0.01)``
   (regularised Coulomb), ``friction_COORD``; ``<limit lower upper>`` of a revolute or
   prismatic joint -> a stop ``limit_COORD`` (``effects.add_stops``); ``<mimic>`` -> a
-  ``coupling`` loop joint ``mimic_COORD``.  All are named effects.
+  ``coupling`` loop joint ``mimic_COORD``.  All are named effects;
+* a link's ``<visual>`` elements are its body's drawing shapes (``visuals``: meshes found
+  through ``mesh_path``, drawn by the pictures).
 """
 from __future__ import annotations
 
@@ -31,6 +33,7 @@ from ...elements.expressions import RESERVED
 from ...names import identifier_problem
 from .effects import add_effects
 from .tree import check_inertia, link_inertia, rpy_matrix, tree_order
+from .visuals import link_shapes
 
 #: the joint kind each URDF type becomes
 KINDS = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic",
@@ -42,8 +45,10 @@ class RobotBuilder:
     """Adds one ``Robot`` to ``system``; ``report`` says what was read and made,
     ``warnings`` what the user should know, ``bodies`` and ``joints`` the names added."""
 
-    def __init__(self, system, reader, robot, floating=False, accept_inertia=False):
+    def __init__(self, system, reader, robot, floating=False, accept_inertia=False,
+                 mesh_path=()):
         self.system, self.reader, self.robot = system, reader, robot
+        self.mesh_path, self.missing_meshes = list(mesh_path or ()), set()
         self.floating, self.accept = bool(floating), bool(accept_inertia)
         self.warnings, self.bodies, self.joints = [], [], []
         self.taken = set(system.parameters) | {"t"}
@@ -90,9 +95,11 @@ class RobotBuilder:
                     self.warnings.append(f"{self.reader.file}: link 'world' is the ground; "
                                          "its <inertial> is not used")
                 continue
+            shapes = link_shapes(link, self.reader.file, self.mesh_path, self.warnings,
+                                 self.missing_meshes) or None
             if link.inertial is None or (link.inertial.mass == 0 and (
                     link.inertial.inertia is None or not any(link.inertial.inertia))):
-                self.system.add_frame(name)
+                self.system.add_frame(name, shape=shapes)
                 self.report["massless"].append(name)
             else:
                 mass, com, inertia = link_inertia(link.inertial)
@@ -101,7 +108,7 @@ class RobotBuilder:
                     self.warnings.append(warning)
                     self.report["accepted_inertia"].append(name)
                 self.system.add_body(name, mass=mass, com=com.tolist(),
-                                     inertia=inertia.tolist())
+                                     inertia=inertia.tolist(), shape=shapes)
             self.bodies.append(name)
 
     def root_joint(self):
@@ -208,17 +215,17 @@ class RobotBuilder:
         skipped = self.report["not_used"]
         if not skipped:
             return
-        notes = {"link/visual": "meshes and shapes are not drawn yet",
-                 "link/collision": "contacts are not made from them",
+        notes = {"link/collision": "contacts are not made from them",
                  "transmission": "listed by mbdyn info; no actuator model"}
         text = ", ".join(f"<{tag}> ({count}{'; ' + notes[tag] if tag in notes else ''})"
                          for tag, count in skipped.items())
         self.warnings.append(f"{self.reader.file}: not used by mbdyn: {text}")
 
 
-def add_robot(system, reader, robot, floating=False, accept_inertia=False):
+def add_robot(system, reader, robot, floating=False, accept_inertia=False, mesh_path=()):
     """Add ``robot`` to ``system``; the ``RobotBuilder`` (its ``report``, ``warnings``,
-    ``bodies``, ``joints``)."""
-    builder = RobotBuilder(system, reader, robot, floating, accept_inertia)
+    ``bodies``, ``joints``).  ``mesh_path``: folders ``package://`` meshes are looked for
+    in (``visuals``)."""
+    builder = RobotBuilder(system, reader, robot, floating, accept_inertia, mesh_path)
     builder.build()
     return builder

@@ -4,7 +4,9 @@ Malformed XML, entity declarations (an entity bomb such as "billion laughs", or 
 external entity that would read another file) and external references are refused
 before anything is expanded.  What is read, each value checked (finite numbers within
 ``mbdyn.limits``): ``<link>`` (``<inertial>``: ``<origin>``, ``<mass>``, ``<inertia>``;
-``<visual>`` and ``<collision>`` counted), ``<joint>`` (``<origin>``, ``<parent>``,
+``<visual>``: ``<origin>``, ``<geometry>`` (mesh filename and scale, box, cylinder,
+sphere), ``<material>`` colour, its own or a top-level ``<material>``'s; ``<collision>``
+counted), ``<joint>`` (``<origin>``, ``<parent>``,
 ``<child>``, ``<axis>``, ``<limit>``, ``<dynamics>``, ``<mimic>``), ``<transmission>``
 (its type, joints, actuators and their reductions).  Every other tag is counted in
 ``Robot.not_used`` (``mbdyn info`` and a warning name it).  Errors are
@@ -39,10 +41,19 @@ class Inertial:
 
 
 @dataclass
+class Visual:
+    kind: str                        # "mesh", "box", "cylinder", "sphere" (else "none")
+    xyz: tuple = (0.0, 0.0, 0.0)
+    rpy: tuple = (0.0, 0.0, 0.0)
+    values: dict = field(default_factory=dict)   # filename, scale; size; radius, length
+    color: str | None = None         # "#rrggbb" of the material's rgba, if given
+
+
+@dataclass
 class Link:
     name: str
     inertial: Inertial | None
-    visuals: list = field(default_factory=list)      # geometry kinds, e.g. "mesh"
+    visuals: list = field(default_factory=list)      # Visual records, in file order
 
 
 @dataclass
@@ -74,6 +85,7 @@ class Reader:
     def __init__(self, file):
         self.file = str(file)
         self.not_used = {}
+        self.materials = {}          # top-level <material name>: "#rrggbb"
 
     def error(self, where, problem):
         return ModelFileError(self.file, where, problem)
@@ -132,14 +144,46 @@ class Reader:
         visuals = []
         for child in element:
             if child.tag == "visual":
-                geometry = child.find("geometry")
-                kinds = [g.tag for g in geometry] if geometry is not None else []
-                visuals.append(kinds[0] if kinds else "none")
-            if child.tag in ("visual", "collision"):
+                visuals.append(self.visual(child, where))
+            elif child.tag == "collision":
                 self.skip(f"link/{child.tag}")
             elif child.tag not in _LINK_TAGS:
                 self.skip(f"link/{_tag(child)}")
         return Link(name, inertial, visuals)
+
+    def visual(self, element, where):
+        """A ``<visual>``'s ``Visual``: its origin, geometry and colour."""
+        where = where + ": <visual>"
+        xyz, rpy = self.origin(element, where)
+        geometry = element.find("geometry")
+        shapes = [g for g in geometry if isinstance(g.tag, str)] if geometry is not None \
+            else []
+        visual = Visual(shapes[0].tag if shapes else "none", xyz, rpy)
+        g, values = (shapes[0] if shapes else None), visual.values
+        if visual.kind == "mesh":
+            values["filename"] = self.attribute(g, "filename", where)
+            values["scale"] = self.numbers(g.get("scale"), 3, where, "mesh scale",
+                                           (1.0, 1.0, 1.0))
+        elif visual.kind == "box":
+            values["size"] = self.numbers(self.attribute(g, "size", where), 3, where,
+                                          "box size", None)
+        elif visual.kind in ("cylinder", "sphere"):
+            for key in ("radius", "length") if visual.kind == "cylinder" else ("radius",):
+                values[key] = self.number(self.attribute(g, key, where), where,
+                                          f"{visual.kind} {key}")
+        material = element.find("material")
+        if material is not None:
+            visual.color = self.colour(material, where) or \
+                self.materials.get(material.get("name", "").strip())
+        return visual
+
+    def colour(self, material, where):
+        """``"#rrggbb"`` of a ``<material>``'s ``<color rgba>`` (``None`` without one)."""
+        found = material.find("color")
+        if found is None or found.get("rgba") is None:
+            return None
+        rgba = self.numbers(found.get("rgba"), 4, where, "color rgba", None)
+        return "#" + "".join(f"{round(255 * min(max(c, 0.0), 1.0)):02x}" for c in rgba[:3])
 
     def inertial(self, element, where):
         xyz, rpy = self.origin(element, where + ": <inertial>")
@@ -255,6 +299,10 @@ def read_robot(reader, root):
                            "URDF file?")
     name = root.get("name", "").strip() or "robot"
     links, joints, transmissions = {}, {}, []
+    for element in root.findall("material"):     # named colours the visuals may use
+        colour = reader.colour(element, f"material {element.get('name', '')!r}")
+        if colour:
+            reader.materials[element.get("name", "").strip()] = colour
     for element in root:
         tag = _tag(element)
         if "}" in str(element.tag) and "xacro" in str(element.tag):
@@ -272,6 +320,8 @@ def read_robot(reader, root):
                 raise reader.error(f"joint {joint.name!r}", "is defined twice; joint names "
                                    "must be unique")
             joints[joint.name] = joint
+        elif element.tag == "material":
+            pass
         elif element.tag == "transmission":
             transmissions.append(reader.transmission(element))
             reader.skip("transmission")

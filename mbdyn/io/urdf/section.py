@@ -1,7 +1,9 @@
 """``[model] urdf = "robot.urdf"``: the URDF a model file includes (or the ``.urdf`` file
 ``load_model`` was given, whose document is only this key), read before the ``System`` is
 made (it names the model) and added to it before the file's own bodies and joints, which
-may then hang from its links.  ``floating`` and ``accept_inertia`` go with it.
+may then hang from its links.  ``floating``, ``accept_inertia`` and ``mesh_path`` (a
+folder or a list of folders, relative to the model file, where ``package://`` meshes are
+looked for) go with it.
 """
 from __future__ import annotations
 
@@ -13,7 +15,7 @@ from ..errors import ModelFileError
 from . import add_robot, is_urdf
 from .parse import Reader, parse_urdf
 
-OPTIONS = ("floating", "accept_inertia")
+OPTIONS = ("floating", "accept_inertia", "mesh_path")
 
 
 def read_section(b, model_table):
@@ -50,10 +52,15 @@ def add_section(b, read):
     path, robot = read
     model_table = b.doc.get("model", {})
     own = path == b.file
+    folders = model_table.get("mesh_path", [])
+    folders = [folders] if isinstance(folders, str) else list(folders)
+    base = os.path.dirname(os.path.abspath(str(b.file)))
+    folders = [os.path.join(base, os.path.expanduser(f)) for f in folders]
     with b.engine(() if own else ("model", "urdf")):
         builder = add_robot(b.system, Reader(path), robot,
                             floating=model_table.get("floating", False),
-                            accept_inertia=model_table.get("accept_inertia", False))
+                            accept_inertia=model_table.get("accept_inertia", False),
+                            mesh_path=folders)
     for message in builder.warnings:
         warnings.warn(message, ModelWarning, stacklevel=2)
     bodies = [{"name": n, "urdf": True} for n in builder.bodies]
