@@ -21,7 +21,6 @@ import os
 for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS"):
     os.environ[_var] = "1"
 
-import gc  # noqa: E402
 import statistics  # noqa: E402
 import sys  # noqa: E402
 import warnings  # noqa: E402
@@ -35,34 +34,11 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 import mbdyn as mb  # noqa: E402
+from timing import per_call  # noqa: E402  (this folder)
 
 ARM = ROOT / "models" / "pd_arm.toml"
 POSE = np.array([0.5, -0.6, 1.2])
 KP, KD = 400.0, 40.0
-
-
-def per_call(fn, budget=0.05, rounds=15):
-    """Median us per call of ``fn()`` over ``rounds`` blocks of about ``budget`` s."""
-    fn()
-    n = 1
-    while True:
-        t0 = perf_counter()
-        for _ in range(n):
-            fn()
-        if perf_counter() - t0 > budget / 4 or n > 1 << 20:
-            break
-        n *= 2
-    out = []
-    gc.disable()
-    try:
-        for _ in range(rounds):
-            t0 = perf_counter()
-            for _ in range(n):
-                fn()
-            out.append((perf_counter() - t0) / n * 1e6)
-    finally:
-        gc.enable()
-    return statistics.median(out)
 
 
 def timed(fn, rounds=7):

@@ -98,7 +98,6 @@ for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS",
     os.environ[_var] = "1"
 
 import argparse  # noqa: E402
-import gc  # noqa: E402
 import importlib  # noqa: E402
 import json  # noqa: E402
 import math  # noqa: E402
@@ -118,6 +117,7 @@ sys.path.insert(0, str(ROOT / "tests"))        # loop_references: published data
 import numpy as np  # noqa: E402
 
 import forward_dynamics as fdb  # noqa: E402
+from timing import interleaved_cpu  # noqa: E402
 import loop_references as lr  # noqa: E402
 
 NOTES = []
@@ -629,24 +629,6 @@ def exudyn_fourbar(exu, P, q0, u0, t_end, steps):
 
 
 # ---------------------------------------------------------------- runs
-def interleaved(runs, rounds):
-    """``{name: [CPU seconds]}`` of whole calls, one call each per round, the order rotated
-    round by round, garbage collector off."""
-    cpu = {k: [] for k in runs}
-    keys = list(runs)
-    gc.collect()
-    gc.disable()
-    try:
-        for r in range(rounds):
-            for k in keys[r % len(keys):] + keys[:r % len(keys)]:
-                c0 = time.process_time()
-                runs[k]()
-                cpu[k].append(time.process_time() - c0)
-    finally:
-        gc.enable()
-    return cpu
-
-
 def loosest(rtols, error_of, target):
     """The loosest rtol at which ``error_of`` and the next tighter one both meet
     ``target`` (``(rtol, error)``), or ``(None, errors)``."""
@@ -795,9 +777,9 @@ def mechanism_runs(mb, exu, name, model, q0, u0, t_end, error_of_q, scipy_setup,
                                   "first_cpu": cpu}
                 runs["exudyn"] = run
         heavy = "exudyn" in info and info["exudyn"]["long"] > LONG_RUN
-        cpu = interleaved(runs, 1 if heavy else rounds)
+        cpu = interleaved_cpu(runs, 1 if heavy else rounds)
         if heavy:                       # one more round of the light ones; Exudyn's
-            more = interleaved({k: v for k, v in runs.items() if k != "exudyn"},
+            more = interleaved_cpu({k: v for k, v in runs.items() if k != "exudyn"},
                                max(1, rounds - 1))
             for k, v in more.items():
                 cpu[k].extend(v)

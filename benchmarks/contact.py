@@ -29,7 +29,6 @@ for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS"):
     os.environ[_var] = "1"
 
 import argparse  # noqa: E402
-import gc  # noqa: E402
 import math  # noqa: E402
 import sys  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -42,30 +41,7 @@ sys.path.insert(0, str(ROOT))
 
 import mbdyn as mb  # noqa: E402
 from mbdyn.kernels import forces as kf  # noqa: E402
-
-
-def per_call(fn, budget=0.05, rounds=9):
-    """Median us per call of ``fn()`` over ``rounds`` blocks of about ``budget`` s."""
-    fn()
-    n = 1
-    while True:
-        t0 = perf_counter()
-        for _ in range(n):
-            fn()
-        if perf_counter() - t0 > budget / 4 or n > 1 << 20:
-            break
-        n *= 2
-    out = []
-    gc.disable()
-    try:
-        for _ in range(rounds):
-            t0 = perf_counter()
-            for _ in range(n):
-                fn()
-            out.append((perf_counter() - t0) / n * 1e6)
-    finally:
-        gc.enable()
-    return float(np.median(out))
+from timing import per_call  # noqa: E402  (this folder)
 
 
 # ----------------------------------------------------------------------------- part 1
@@ -110,8 +86,8 @@ def scaling(sizes):
             q = model.default_coordinates()
             u = 0.01 * rng.normal(size=model.nu)
             model.forward_dynamics(q, u)            # the kinematics in the workspace
-            kernel = per_call(force_kernel(model))
-            whole = per_call(lambda: model.forward_dynamics(q, u))
+            kernel = per_call(force_kernel(model), rounds=9)
+            whole = per_call(lambda: model.forward_dynamics(q, u), rounds=9)
             row.append((kernel, whole))
         (ks, ws), (ka, wa) = row
         print(f"{n:>5} {n * (n + 1) // 2:>7} | {ks:>10.1f} {ka:>10.1f} {ka / ks:>6.1f} | "

@@ -16,8 +16,6 @@ import os
 for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS"):
     os.environ[_var] = "1"
 
-import gc  # noqa: E402
-import statistics  # noqa: E402
 import sys  # noqa: E402
 import warnings  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -27,29 +25,7 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 import mbdyn as mb  # noqa: E402
-
-
-def per_call(fn, budget=0.05, rounds=11):
-    fn()
-    n = 1
-    while True:
-        t0 = perf_counter()
-        for _ in range(n):
-            fn()
-        if perf_counter() - t0 > budget / 4 or n > 1 << 18:
-            break
-        n *= 2
-    out = []
-    gc.disable()
-    try:
-        for _ in range(rounds):
-            t0 = perf_counter()
-            for _ in range(n):
-                fn()
-            out.append((perf_counter() - t0) / n * 1e6)
-    finally:
-        gc.enable()
-    return statistics.median(out)
+from timing import per_call  # noqa: E402  (this folder)
 
 
 def shaft(modes, elements):
@@ -66,7 +42,7 @@ def main():
     rng = np.random.default_rng(0)
     rigid = shaft(2, 10).compile(effects="-flexibility_shaft")
     q, u = rng.normal(size=rigid.nq), rng.normal(size=rigid.nu)
-    base = per_call(lambda: rigid.forward_dynamics(q, u))
+    base = per_call(lambda: rigid.forward_dynamics(q, u), rounds=11, most=1 << 18)
     t0 = perf_counter()
     print("| modes | elements | us per forward_dynamics | ratio to the rigid body | "
           "compile (s) |")
@@ -77,7 +53,8 @@ def main():
         m = shaft(modes, elements).compile()
         build = perf_counter() - t0
         q, u = rng.normal(size=m.nq) * 1e-3, rng.normal(size=m.nu) * 1e-3
-        c = per_call(lambda m=m, q=q, u=u: m.forward_dynamics(q, u))
+        c = per_call(lambda m=m, q=q, u=u: m.forward_dynamics(q, u), rounds=11,
+                     most=1 << 18)
         print(f"| {modes} | {elements} | {c:.1f} | {c / base:.0f} | {build:.2f} |")
 
 

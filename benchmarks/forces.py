@@ -21,14 +21,12 @@ for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS"):
     os.environ[_var] = "1"
 
 import argparse  # noqa: E402
-import gc  # noqa: E402
 import json  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
 import tempfile  # noqa: E402
 import warnings  # noqa: E402
 from pathlib import Path  # noqa: E402
-from time import perf_counter  # noqa: E402
 
 import numpy as np  # noqa: E402
 
@@ -36,29 +34,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
-
-def per_call(fn, budget=0.05, rounds=15):
-    """Median us per call of ``fn()`` over ``rounds`` blocks of about ``budget`` s."""
-    fn()
-    n = 1
-    while True:
-        t0 = perf_counter()
-        for _ in range(n):
-            fn()
-        if perf_counter() - t0 > budget / 4 or n > 1 << 20:
-            break
-        n *= 2
-    out = []
-    gc.disable()
-    try:
-        for _ in range(rounds):
-            t0 = perf_counter()
-            for _ in range(n):
-                fn()
-            out.append((perf_counter() - t0) / n * 1e6)
-    finally:
-        gc.enable()
-    return float(np.median(out))
+from timing import per_call  # noqa: E402  (this folder)
 
 
 def interleaved(calls, rounds=15):

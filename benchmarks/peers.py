@@ -70,7 +70,6 @@ for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS",
     os.environ[_var] = "1"
 
 import argparse  # noqa: E402
-import gc  # noqa: E402
 import importlib  # noqa: E402
 import json  # noqa: E402
 import statistics  # noqa: E402
@@ -80,6 +79,7 @@ import warnings  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import forward_dynamics as fdb  # noqa: E402  (this folder: chains and the per-call timer)
+from timing import interleaved_cpu  # noqa: E402
 import numpy as np  # noqa: E402
 
 ROWS = ("1", "2", "3", "4", "5", "acc")
@@ -101,21 +101,9 @@ def peer(module):
 
 
 def interleaved(runs, rounds):
-    """``{name: median CPU seconds}`` of whole calls ``runs = {name: fn}``, one call each
-    per round, the order rotated round by round, garbage collector off."""
-    cpu = {k: [] for k in runs}
-    keys = list(runs)
-    gc.collect()
-    gc.disable()
-    try:
-        for r in range(rounds):
-            for k in keys[r % len(keys):] + keys[:r % len(keys)]:
-                c0 = time.process_time()
-                runs[k]()
-                cpu[k].append(time.process_time() - c0)
-    finally:
-        gc.enable()
-    return {k: statistics.median(v) for k, v in cpu.items()}
+    """``{name: median CPU seconds}`` of whole calls ``runs = {name: fn}``, timed
+    round-robin (``timing.interleaved_cpu``)."""
+    return {k: statistics.median(v) for k, v in interleaved_cpu(runs, rounds).items()}
 
 
 def row(measure, mbdyn, peer_value, goal, unit="s", peer_name=""):

@@ -42,18 +42,14 @@ try:
 except ImportError:  # pragma: no cover - the generator's own environment
     sys.exit("this generator needs Pinocchio: pip install pin example-robot-data "
              "(in an environment of their own)")
+from robots import ERD_ROBOTS
 from urdf_reference import names_of, one_state, random_state
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DATA = os.path.join(HERE, "..", "tests", "data")
-# (name, path under robots/, floating base, options for mbdyn's reader)
-ROBOTS = [
-    ("ur5", "ur_description/urdf/ur5_robot.urdf", False, {}),
-    ("panda", "panda_description/urdf/panda.urdf", False, {"strip_mimic": True}),
-    ("solo12", "solo_description/robots/solo12.urdf", True, {}),
-    ("tiago", "tiago_description/robots/tiago_no_hand.urdf", False,
-     {"accept_inertia": True}),
-]
+# (name, path under robots/, floating base, options for mbdyn's reader): the robots
+# benchmarks/robots.py times
+ROBOTS = ERD_ROBOTS
 STATES = 2
 FRAMES = 6
 SEED = 2026

@@ -26,6 +26,7 @@ import numpy as np
 import pytest
 
 import mbdyn as mb
+from reference_states import indices, states
 
 DATA = pathlib.Path(__file__).resolve().parent / "data"
 REFERENCE = json.loads((DATA / "robot_reference.json").read_text())
@@ -89,17 +90,8 @@ def load(entry):
 def robot(request):
     entry = next(r for r in REFERENCE["robots"] if r["name"] == request.param)
     model = load(entry)
-    qi = [model.coordinates.index(n) for n in entry["coordinates"]]
-    ui = [model.speeds.index(n) for n in entry["speeds"]]
-    assert sorted(qi) == list(range(model.nq)) and sorted(ui) == list(range(model.nu))
+    qi, ui = indices(model, entry)
     return model, entry, qi, ui
-
-
-def states(model, entry, qi, ui):
-    for st in entry["states"]:
-        q, u = np.zeros(model.nq), np.zeros(model.nu)
-        q[qi], u[ui] = st["q"], st["u"]
-        yield st, q, u
 
 
 def test_gravity_is_the_references(robot):

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 import mbdyn as mb
+from reference_states import indices, states
 
 DATA = pathlib.Path(__file__).resolve().parent / "data"
 REFERENCE = json.loads((DATA / "urdf_reference.json").read_text())
@@ -34,17 +35,8 @@ def robot(request):
     scene = mb.load_model(DATA / file, floating=floating)
     # Pinocchio's dynamics hold no dampers, friction or stops: switch them off
     model = scene.system.compile(effects=[f"-{n}" for n in scene.system.forces])
-    qi = [model.coordinates.index(n) for n in entry["coordinates"]]
-    ui = [model.speeds.index(n) for n in entry["speeds"]]
-    assert sorted(qi) == list(range(model.nq)) and sorted(ui) == list(range(model.nu))
+    qi, ui = indices(model, entry)
     return model, entry, qi, ui
-
-
-def states(model, entry, qi, ui):
-    for st in entry["states"]:
-        q, u = np.zeros(model.nq), np.zeros(model.nu)
-        q[qi], u[ui] = st["q"], st["u"]
-        yield st, q, u
 
 
 def test_gravity_is_the_references(robot):
