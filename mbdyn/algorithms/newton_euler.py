@@ -27,25 +27,33 @@ def _lu_solve(A, b):
     return x
 
 
+def tree_order(model, q, u, t):
+    """The Newton-Euler equations eliminated in tree order, in one compiled call: ``u'``
+    in ``model._ud``, the reaction components in ``model._lam``, every joint's wrench in
+    ``model._W`` (world components, about the child's origin); a failure raised, named."""
+    q, u = model._state(q, u)
+    if model._python_inputs:
+        model._fill_inputs(q, u, t)
+    try:
+        status = kp.newton_euler_tree_packed(*model._packed, q, u)
+    except ZeroDivisionError:
+        raise model._division_by_zero(q, t) from None
+    if status >= 0:
+        model._raise_singular(q, t, status)
+    if status == -2:
+        model._check_finite(q, u, t, np.concatenate([model._ud, model._lam]),
+                            "the Newton-Euler solution")
+
+
 def solve(model, q, u, t, dense=False):
     """The Newton-Euler unknowns ``[u', reactions]`` (a new array): eliminated in tree
     order (``kernels.articulated``), or, with ``dense``, the system of
     ``kernels.dynamics.newton_euler_system`` solved by LU (from Python: it needs no
     compiled entry point beyond the kinematics a run has compiled anyway)."""
-    q, u = model._state(q, u)
     if not dense:
-        if model._python_inputs:
-            model._fill_inputs(q, u, t)
-        try:
-            status = kp.newton_euler_tree_packed(*model._packed, q, u)
-        except ZeroDivisionError:
-            raise model._division_by_zero(q, t) from None
-        if status >= 0:
-            model._raise_singular(q, t, status)
-        x = np.concatenate([model._ud, model._lam])
-        if status == -2:
-            model._check_finite(q, u, t, x, "the Newton-Euler solution")
-        return x
+        tree_order(model, q, u, t)
+        return np.concatenate([model._ud, model._lam])
+    q, u = model._state(q, u)
     try:
         # the steps of newton_euler_solution with kernels a run compiles anyway, and
         # the LU solve from Python: no fused entry point of its own to compile

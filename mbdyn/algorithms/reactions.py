@@ -9,9 +9,9 @@ import numpy as np
 
 from ..errors import ModelError
 from ..kernels import dynamics as kd
-from ..kernels import packed as kp
 from .forward_dynamics import ARTICULATED_FROM, METHODS
 from .loop_newton_euler import loop_newton_euler_reactions
+from .newton_euler import tree_order
 from .loop_reactions import child_rotation, loop_reactions
 
 
@@ -70,15 +70,7 @@ def reaction_array(model, q, u, t=0.0, frame="world"):
     if model._con is not None:
         out = reactions(model, q, u, t, frame=frame)
         return np.array([np.concatenate(out[name]) for name in model.joints])
-    q, u = model._state(q, u)
-    if model._python_inputs:
-        model._fill_inputs(q, u, t)
-    try:
-        status = kp.newton_euler_tree_packed(*model._packed, q, u)
-    except ZeroDivisionError:
-        raise model._division_by_zero(q, t) from None
-    if status != -1:
-        model._newton_euler(q, u, t)              # raises the precise error
+    tree_order(model, q, u, t)
     w = model._W.copy()
     if frame == "child":
         R = model._R

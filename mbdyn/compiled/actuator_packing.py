@@ -78,6 +78,8 @@ def put_source(model, data, value, element, key, time_only=False):
         return data.put(value.block()), value.mode
     if isinstance(value, sympy.Basic) and value.free_symbols:
         expr, codes = _numeric(model, value, element, key)
+        if not expr.free_symbols:                     # parameters only: a constant
+            return data.put([float(expr)]), ka.CONSTANT
         if time_only and any(s.name != "t" for s in expr.free_symbols):
             raise ModelError(f"{element}: {key} must be a function of t alone (the "
                              "controller compares the coordinate with it)")
@@ -110,6 +112,9 @@ def pack_actuator(model, el, element, row, data, laws):
     carried = _carried(model, j) if p.get("gravity_compensation") else []
     clock = model._clock[0] if model._clock is not None else -1
     setpoint = p.get("setpoint", 0.0)
+    if isinstance(setpoint, sympy.Basic):          # of parameters only: a constant
+        expr = _numeric(model, setpoint, element, "setpoint")[0]
+        setpoint = setpoint if expr.free_symbols else float(expr)
     off = data.put([ka.TYPES[kind], 1.0 if j.kind == "prismatic" else 0.0, clock,
                     p["limit"], p.get("kp", p.get("stall_torque", 0.0)),
                     p.get("kd", p.get("no_load_speed", 0.0)), p.get("ki", 0.0),

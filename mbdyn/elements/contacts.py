@@ -19,9 +19,9 @@ import numpy as np
 
 from ..errors import ModelError
 from ..names import identifier_problem
-from .force_kinds import hunt_crossley_factor, radial_directions
+from .force_kinds import compliant_law, radial_directions
 from .force_values import number
-from .forces import GLOBAL_EFFECTS, ForceElement
+from .forces import ForceElement, check_name
 from .values import _vector3, numeric, parse_axis, parse_orientation
 
 SHAPE_KINDS = ("sphere", "plane", "box", "capsule", "cylinder", "cam")
@@ -178,12 +178,7 @@ def make_contact(name, shapes, parameters=None, pairs=None, group=None, **kw):
     ContactShape}``, those of the system): ``pairs`` (a list of two shape names each) or
     ``group`` (shape names: every pair of them whose shapes are on different bodies)."""
     element = f"contact {name!r}"
-    problem = identifier_problem(name)
-    if problem:
-        raise ModelError(f"contact {name!r}: the name {problem}; it names the element's "
-                         "effect")
-    if name in GLOBAL_EFFECTS:
-        raise ModelError(f"{element}: the name is reserved for the {name} effect")
+    check_name(element, name)
     extra = sorted(set(kw) - set(CONTACT_KEYS))
     if extra:
         raise ModelError(f"{element}: unknown key(s) {', '.join(extra)}; known: pairs, "
@@ -192,7 +187,7 @@ def make_contact(name, shapes, parameters=None, pairs=None, group=None, **kw):
         raise ModelError(f"{element}: give pairs = [[shape, shape], ...] or group = [shape, "
                          "...] (one of them)")
     used, index_pairs = _pairs(element, shapes, pairs, group)
-    params = _law(element, parameters or {}, kw)
+    params = compliant_law(element, parameters or {}, kw)   # as the floor contact's
     broad = kw.get("broad_phase", True)
     if not isinstance(broad, (bool, np.bool_)):
         raise ModelError(f"{element}: broad_phase must be true or false, got {broad!r}")
@@ -243,32 +238,3 @@ def _pairs(element, shapes, pairs, group):
                              + (" (list the pairs you need with pairs = [...])"
                                 if pairs is None else ""))
     return used, todo
-
-
-def _law(element, parameters, kw):
-    """The force law's numbers, read and checked as the floor contact's."""
-    if kw.get("stiffness") is None:
-        raise ModelError(f"{element}: missing stiffness (N/m^exponent) of the contact")
-
-    def num(key, default, **check):
-        return number(kw.get(key, default), parameters, element, key, **check)
-    params = {
-        "stiffness": num("stiffness", None, positive=True),
-        "exponent": num("exponent", 1.5, positive=True),
-        "restitution": num("restitution", 1.0, minimum=0.0),
-        "impact_speed": num("impact_speed", 1.0, positive=True),
-        "friction": num("friction", 0.0, minimum=0.0),
-        "slip_speed": num("slip_speed", 1e-3, positive=True),
-    }
-    if params["restitution"] > 1.0:
-        raise ModelError(f"{element}: restitution must be in (0, 1], got "
-                         f"{params['restitution']:g}")
-    if params["restitution"] == 0.0:
-        raise ModelError(f"{element}: restitution 0 needs infinite damping; give a small "
-                         "positive value such as 0.05")
-    try:
-        factor = hunt_crossley_factor(params["restitution"], params["exponent"])
-    except ModelError as exc:
-        raise ModelError(f"{element}: {exc}") from None
-    params["damping_factor"] = factor / params["impact_speed"]
-    return params

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..errors import ModelError
 from .actuators import joint_stop
-from .force_values import make_law
+from .force_values import make_law, number
 from .tables import Table, make_table
 from .values import numeric, parse_axis
 
@@ -223,12 +223,29 @@ def contact(g):
         "plane_point": g.vector("plane_point"),
         "plane_normal": parse_axis(numeric(normal, g.parameters, element, "plane_normal"),
                                    element),
-        "stiffness": num(kw["stiffness"], what="stiffness", positive=True),
-        "exponent": num(kw.get("exponent", 1.5), what="exponent", positive=True),
-        "restitution": num(kw.get("restitution", 1.0), what="restitution", minimum=0.0),
-        "impact_speed": num(kw.get("impact_speed", 1.0), what="impact_speed", positive=True),
-        "friction": num(kw.get("friction", 0.0), what="friction", minimum=0.0),
-        "slip_speed": num(kw.get("slip_speed", 1e-3), what="slip_speed", positive=True),
+        **compliant_law(element, g.parameters, kw),
+    }
+    return params, (kw["body"],)
+
+
+def compliant_law(element, parameters, kw):
+    """The numbers of a compliant contact's law from its keys ``kw``, read and checked:
+    ``stiffness`` (required), ``exponent``, ``restitution`` in (0, 1] at
+    ``impact_speed``, ``friction``, ``slip_speed``, and the Hunt-Crossley
+    ``damping_factor`` per unit speed they make (the floor contact's and the contacts
+    between shapes')."""
+    if kw.get("stiffness") is None:
+        raise ModelError(f"{element}: missing stiffness (N/m^exponent) of the contact")
+
+    def num(key, default, **check):
+        return number(kw.get(key, default), parameters, element, key, **check)
+    params = {
+        "stiffness": num("stiffness", None, positive=True),
+        "exponent": num("exponent", 1.5, positive=True),
+        "restitution": num("restitution", 1.0, minimum=0.0),
+        "impact_speed": num("impact_speed", 1.0, positive=True),
+        "friction": num("friction", 0.0, minimum=0.0),
+        "slip_speed": num("slip_speed", 1e-3, positive=True),
     }
     if params["restitution"] > 1.0:
         raise ModelError(f"{element}: restitution must be in (0, 1], got "
@@ -241,7 +258,7 @@ def contact(g):
     except ModelError as exc:
         raise ModelError(f"{element}: {exc}") from None
     params["damping_factor"] = factor / params["impact_speed"]
-    return params, (kw["body"],)
+    return params
 
 
 @functools.lru_cache(maxsize=64)

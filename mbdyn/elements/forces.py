@@ -96,6 +96,16 @@ class ForceElement:
                 f"e = {p['restitution']:g}, mu = {p['friction']:g}")
 
 
+def check_name(element, name):
+    """An element's ``name`` names its effect: an identifier, not a global effect's."""
+    problem = identifier_problem(name)
+    if problem:
+        raise ModelError(f"{element}: the name {problem}; it names the element's effect")
+    if name in GLOBAL_EFFECTS:
+        raise ModelError(f"{element}: the name is reserved for the {name} effect; choose "
+                         "another")
+
+
 def describe_actuator(p):
     """One line for ``mbdyn info`` of an actuator's parameters ``p``."""
     kind = p["type"]
@@ -125,13 +135,7 @@ def _signal_text(value):
 
 def actuator(name, joint, kind, parameters=None, **kw):
     """Validate and build an actuator (a ``ForceElement`` of kind ``actuator``)."""
-    problem = identifier_problem(name)
-    if problem:
-        raise ModelError(f"actuator {name!r}: the name {problem}; it names the element's "
-                         "effect")
-    if name in GLOBAL_EFFECTS:
-        raise ModelError(f"actuator {name!r}: the name is reserved for the {name} effect; "
-                         "choose another")
+    check_name(f"actuator {name!r}", name)
     symbolic = {k: v for k, v in kw.items() if not isinstance(v, str) and has_symbols(v)}
     params = make_actuator(name, joint, kind, parameters, **kw)
     return ForceElement(name, "actuator", (), params, symbolic)
@@ -142,13 +146,7 @@ def make_force(name, kind, parameters=None, gravity=(0.0, 0.0, -9.81), **kw):
     ``System.add_force``); each kind's keys are read by its builder in ``BUILDERS``."""
     element = f"force {name!r}"
     parameters = parameters or {}
-    problem = identifier_problem(name)
-    if problem:
-        raise ModelError(f"force {name!r}: the name {problem}; it names the element's "
-                         "effect")
-    if name in GLOBAL_EFFECTS:
-        raise ModelError(f"{element}: the name is reserved for the {name} effect; choose "
-                         "another")
+    check_name(element, name)
     if kind not in KINDS:
         raise ModelError(f"{element}: unknown kind {kind!r}; use one of {', '.join(KINDS)}")
     symbolic = {k: v for k, v in kw.items() if not isinstance(v, str) and has_symbols(v)}

@@ -56,6 +56,9 @@ class Updates:
                           if a in index else -1 for a in c.actuators])
                      for c in model._controllers]
         self.next = {id(x): t0 for x in list(model._controllers) + list(model._samplers)}
+        #: how close to its next instant a sampler counts as due (round-off of t0 + k/rate)
+        self.tol = 1e-9 / max([1.0] + [x.rate for x in list(model._controllers)
+                                       + list(model._samplers)])
         self.setpoints = {id(s): _function_of_t(s.element.params["setpoint"])
                           for s in model._samplers}
         self.desired = _desired_motions(model) if any(
@@ -69,10 +72,8 @@ class Updates:
 
     def at(self, t, y):
         """Call what is due at ``t`` with the state ``y``."""
-        model = self.model
+        model, tol = self.model, self.tol
         q, u = y[:model.nq], y[model.nq:]
-        tol = 1e-9 / max(1.0, max([c.rate for c in model._controllers]
-                                  + [s.rate for s in model._samplers]))
         for c, slots in self.held:
             if t >= self.next[id(c)] - tol:
                 self.next[id(c)] += 1.0 / c.rate

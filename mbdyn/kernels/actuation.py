@@ -82,7 +82,7 @@ def clock(data, off, qfull):
 
 
 @njit(**UNCOUNTED)
-def gravity_effort(data, off, i, axis, com, R, r, e, c, lever):
+def gravity_effort(data, off, i, com, R, r, e, c, lever):
     """The effort that balances gravity on the bodies joint ``i`` carries (the
     generalised gravity force of its coordinate, negated): for a revolute joint
     ``-e . sum (c_b - r_i) x m_b g``, for a prismatic one ``-e . sum m_b g``; ``e`` the
@@ -107,7 +107,7 @@ def gravity_effort(data, off, i, axis, com, R, r, e, c, lever):
 
 
 @njit(**UNCOUNTED)
-def actuator_effort(data, off, row, q, u, qfull, ufull, i, axis, com, R, r, e, work):
+def actuator_effort(data, off, row, q, u, qfull, ufull, i, com, R, r, e, work):
     """The effort of the actuator whose numbers start at ``data[off]`` on the coordinate
     ``q`` (speed ``u``) of joint ``i`` (world axis ``e``); ``row``: its ``force_int`` row
     (sources at ``row[4:6]``, ``row[6:8]``)."""
@@ -142,7 +142,7 @@ def actuator_effort(data, off, row, q, u, qfull, ufull, i, axis, com, R, r, e, w
         tau = (data[off + A_GAIN] * (setpoint - q) + data[off + A_RATE] * (rate - u)
                + data[off + A_HELD] + data[off + A_FEEDFORWARD])
         if data[off + A_CARRIED] > 0.0:
-            tau += gravity_effort(data, off, i, axis, com, R, r, e, work[0:3], work[3:6])
+            tau += gravity_effort(data, off, i, com, R, r, e, work[0:3], work[3:6])
     limit = data[off + A_LIMIT]
     return min(max(tau, -limit), limit)
 

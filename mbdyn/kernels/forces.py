@@ -166,7 +166,8 @@ def force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r,
             fs, fd, V = _law(force_data, force_int[e, 4], force_int[e, 5], force_int[e, 6],
                              force_int[e, 7], force_data[off + 1], force_data[off + 2],
                              force_data[off + 3], x, xd, tab, qfull, ufull, prog)
-            _joint_effort(i, parent[i], axis, force_data[off + 4] != 0.0, -(fs + fd), R, r,
+            mat_vec(R[i], axis[i], e2)
+            _joint_effort(i, parent[i], e2, force_data[off + 4] != 0.0, -(fs + fd), R, r,
                           com, F, N, e1, pa, zero, lever, t)
             if want:
                 acc[0] += V
@@ -178,14 +179,14 @@ def force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r,
             mat_vec(R[i], axis[i], e2)
             if kind == ACTUATOR:
                 tau = actuator_effort(force_data, off, force_int[e], x, xd, qfull, ufull, i,
-                                      axis, com, R, r, e2, prog)
+                                      com, R, r, e2, prog)
                 if want:        # what it puts in: apart in acc[2] when asked
                     acc[2 if acc.shape[0] >= 3 else 1] += tau * xd
                 prismatic = force_data[off + 1] != 0.0
             else:
                 tau = stop_effort(force_data, off, x, xd, acc, want)
                 prismatic = force_data[off + 4] != 0.0
-            _joint_effort(i, parent[i], axis, prismatic, tau, R, r, com, F, N, e1, pa, zero,
+            _joint_effort(i, parent[i], e2, prismatic, tau, R, r, com, F, N, e1, pa, zero,
                           lever, t)
         elif kind == BUSHING:
             # data: point_a(3), point_b(3), K (6x6 row-major), C (6x6), all in frame a's
@@ -255,20 +256,19 @@ def force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r,
 
 
 @njit(**UNCOUNTED)
-def _joint_effort(i, p, axis, prismatic, tau, R, r, com, F, N, e, at, zero, lever, t):
-    """The effort ``tau`` on the coordinate of joint ``i`` (parent ``p``): a force along a
-    prismatic axis or a moment about a revolute one, on the child and, opposite, on the
-    parent, at the joint's origin."""
-    mat_vec(R[i], axis[i], e)
+def _joint_effort(i, p, e, prismatic, tau, R, r, com, F, N, f, at, zero, lever, t):
+    """The effort ``tau`` on the coordinate of joint ``i`` (parent ``p``; ``e`` its axis in
+    world components): a force along a prismatic axis or a moment about a revolute one, on
+    the child and, opposite, on the parent, at the joint's origin (``f``: scratch)."""
     for q in range(3):
-        e[q] *= tau
+        f[q] = tau * e[q]
         at[q] = r[i, q]
     if prismatic:
-        _apply(i, at, e, zero, 1.0, R, r, com, F, N, lever, t)
-        _apply(p, at, e, zero, -1.0, R, r, com, F, N, lever, t)
+        _apply(i, at, f, zero, 1.0, R, r, com, F, N, lever, t)
+        _apply(p, at, f, zero, -1.0, R, r, com, F, N, lever, t)
     else:
-        _apply(i, at, zero, e, 1.0, R, r, com, F, N, lever, t)
-        _apply(p, at, zero, e, -1.0, R, r, com, F, N, lever, t)
+        _apply(i, at, zero, f, 1.0, R, r, com, F, N, lever, t)
+        _apply(p, at, zero, f, -1.0, R, r, com, F, N, lever, t)
 
 
 @njit(**UNCOUNTED)
