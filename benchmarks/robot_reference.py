@@ -42,7 +42,7 @@ try:
 except ImportError:  # pragma: no cover - the generator's own environment
     sys.exit("this generator needs Pinocchio: pip install pin example-robot-data "
              "(in an environment of their own)")
-from robots import ERD_ROBOTS
+from robots import ERD_ROBOTS, erd_folder
 from urdf_reference import names_of, one_state, random_state
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -56,16 +56,13 @@ SEED = 2026
 
 
 def robots_folder():
-    """example-robot-data's ``robots/``: ``$EXAMPLE_ROBOT_DATA``, else the cmeel prefix
-    of a site folder on ``sys.path`` (the wheel installs no Python module of its own)."""
-    if os.environ.get("EXAMPLE_ROBOT_DATA"):
-        return os.environ["EXAMPLE_ROBOT_DATA"]
-    for entry in sys.path:
-        folder = os.path.join(entry, "cmeel.prefix", "share", "example-robot-data", "robots")
-        if os.path.isdir(folder):
-            return folder
-    sys.exit("example-robot-data not found: pip install example-robot-data, or set "
-             "EXAMPLE_ROBOT_DATA to its robots/ folder")
+    """example-robot-data's ``robots/`` (``robots.erd_folder``), or exit saying how to get
+    it."""
+    folder = erd_folder()
+    if folder is None:
+        sys.exit("example-robot-data not found: pip install example-robot-data, or set "
+                 "EXAMPLE_ROBOT_DATA to its robots/ folder")
+    return folder
 
 
 EXTRA_FRAMES = {"panda": ["panda_rightfinger"], "tiago": ["wheel_right_link"]}

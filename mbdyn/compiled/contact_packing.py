@@ -8,27 +8,18 @@ from __future__ import annotations
 import numpy as np
 
 from ..elements.contacts import cam_spline
-from ..errors import ModelError
 from ..kernels import contact as kc
 from ..kernels.forces import FORCE_WORK
+from .states import frame_slot
 
 MODES = {"pairs": kc.PAIRS, "sweep": kc.SWEEP, "all": kc.ALL}
-
-
-def _frame(model, name, element):
-    if name == "ground":
-        return -1
-    if name not in model._frame_index:
-        raise ModelError(f"{element}: unknown body {name!r}; the model's bodies and frames "
-                         f"are {', '.join(model.frames)}, or 'ground'")
-    return model._frame_index[name]
 
 
 def shape_record(model, shape, element):
     """The ``SREC`` floats of one shape (its cam block offset left at -1)."""
     rec = np.zeros(kc.SREC)
     rec[0] = kc.KINDS[shape.kind]
-    rec[1] = _frame(model, shape.body, f"{element}, shape {shape.name!r}")
+    rec[1] = frame_slot(model, shape.body, f"{element}, shape {shape.name!r}")
     rec[2:5] = shape.position
     rec[5:14] = np.asarray(shape.axes, float).reshape(9)
     rec[14] = shape.bound

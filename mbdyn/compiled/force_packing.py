@@ -13,15 +13,7 @@ from ..kernels import forces as kf
 from ..kernels.actuation import PROGRAM
 from .actuator_packing import law_block, pack_actuator, pack_joint_stop
 from .contact_packing import pack_contact
-
-
-def _frame(model, name, element):
-    if name == "ground":
-        return -1
-    if name not in model._frame_index:
-        raise ModelError(f"{element}: unknown body {name!r}; the model's bodies and frames "
-                         f"are {', '.join(model.frames)}, or 'ground'")
-    return model._frame_index[name]
+from .states import frame_slot
 
 
 def speed_slot(model, name, element):
@@ -72,7 +64,7 @@ def pack_forces(model, forces):
 
 
 def _two_bodies(model, el, element):
-    ia, ib = (_frame(model, n, element) for n in el.frames)
+    ia, ib = (frame_slot(model, n, element) for n in el.frames)
     if ia == ib:
         raise ModelError(f"{element}: body_a and body_b are both {el.frames[0]!r}; a "
                          "spring acts between two bodies (or a body and the ground)"
@@ -137,7 +129,7 @@ def _bushing(model, el, element, row, data, laws):
 
 def _bearing(model, el, element, row, data, laws):
     p = el.params
-    ia, ib = (_frame(model, n, element) for n in el.frames)
+    ia, ib = (frame_slot(model, n, element) for n in el.frames)
     if ia == ib or ia < 0:
         raise ModelError(f"{element}: the shaft body must be a body other than the "
                          "housing")
@@ -157,7 +149,7 @@ def _bearing(model, el, element, row, data, laws):
 
 def _contact(model, el, element, row, data, laws):
     p = el.params
-    i = _frame(model, el.frames[0], element)
+    i = frame_slot(model, el.frames[0], element)
     if i < 0:
         raise ModelError(f"{element}: the ground cannot touch the ground; name a body")
     off = data.put(np.concatenate([p["center"], [p["radius"]], p["plane_point"],

@@ -1,6 +1,6 @@
 """States by name on a compiled model: coordinate and speed vectors from arrays or
 ``{name: value}``, the default coordinates (identity quaternions), and the unit-quaternion
-projection and drift.
+projection and drift; a frame's index by name, as the packers need it.
 """
 from __future__ import annotations
 
@@ -8,6 +8,17 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError, NonFiniteError
+
+
+def frame_slot(model, name, element):
+    """The index of the frame ``name`` (-1: the ground), or a ``ModelError`` naming
+    ``element`` and the frames there are."""
+    if name == "ground":
+        return -1
+    if name not in model._frame_index:
+        raise ModelError(f"{element}: unknown body {name!r}; the model's bodies and frames "
+                         f"are {', '.join(model.frames)}, or 'ground'")
+    return model._frame_index[name]
 
 
 def default_coordinates(model):
