@@ -18,9 +18,10 @@ the same numpy as mbdyn's environment), add its site folder on the way in:
 Both sides read the same file with their own parser; the dampers, friction and stops
 mbdyn makes of a URDF are switched off (Pinocchio's dynamics hold none), and the two are
 checked to agree at the state timed.  mbdyn's entries: the ordinary API
-(``Model.forward_dynamics(q, u)``, its default route; ``inverse_dynamics``, which returns
-dictionaries of efforts and reactions; ``mass_matrix``) and the low-level entry
-(``Model.lowlevel("auto").forward_dynamics``).  Per-call timing is
+(``Model.forward_dynamics(q, u)``, its default route; ``effort_array``, the generalized
+forces as ``rnea`` gives them; ``inverse_dynamics``, which returns dictionaries of efforts
+and reactions; ``mass_matrix``) and the low-level entry (``Model.lowlevel("auto")``:
+``forward_dynamics``, ``inverse_dynamics``, ``mass_matrix``).  Per-call timing is
 ``forward_dynamics.measure`` (blocks sized to a time budget, rounds interleaved); the
 ratio is mbdyn / Pinocchio.
 """
@@ -129,17 +130,22 @@ def robot_rows(path, floating, options, budget, repeats):
     ud = rng.normal(size=model.nu)
     low = model.lowlevel("auto")
     out = np.empty(model.nu)
+    matrix = np.empty((model.nu, model.nu))
     wrenches = np.empty((model.n_frames, 6))
     cases = {
         "fd": (model.forward_dynamics, (q, u), {}, 1),
         "fd_low": (low.forward_dynamics, (q, u, 0.0, out), {}, 1),
-        "id": (model.inverse_dynamics, (q, u, ud), {}, 1),
+        "id": (model.effort_array, (q, u, ud), {}, 1),
+        "id_low": (low.inverse_dynamics, (q, u, ud, 0.0, out), {}, 1),
+        "id_dict": (model.inverse_dynamics, (q, u, ud), {}, 1),
         "M": (model.mass_matrix, (q,), {}, 1),
+        "M_low": (low.mass_matrix, (q, 0.0, matrix), {}, 1),
         "react": (model.reaction_array, (q, u), {}, 1),
         "react_low": (low.reactions, (q, u, 0.0, wrenches), {}, 1),
         "react_dict": (model.reactions, (q, u), {}, 1),
     }
-    ratios = [("fd", "aba"), ("fd_low", "aba"), ("id", "rnea"), ("M", "crba"),
+    ratios = [("fd", "aba"), ("fd_low", "aba"), ("id", "rnea"), ("id_low", "rnea"),
+              ("id_dict", "rnea"), ("M", "crba"), ("M_low", "crba"),
               ("react", "aba_rnea"), ("react_low", "aba_rnea"), ("react_dict", "aba_rnea")]
     if not floating:                         # the free flyer's speeds differ: not mapped
         qp, vp = pin_state(pmodel, model, q, u)
@@ -174,9 +180,10 @@ def main():
     import pinocchio as pin
     print(f"Pinocchio {pin.__version__}; microseconds per call (median), ratio mbdyn / "
           "Pinocchio\n")
-    print("| robot | nu | fd (ordinary) | fd (low-level) | aba | id | rnea | M | crba | "
+    print("| robot | nu | fd (ordinary) | fd (low-level) | aba | id (ordinary) | id (low-level) "
+          "| id (dicts) | rnea | M (ordinary) | M (low-level) | crba | "
           "load mbdyn / Pinocchio (ms) |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     reaction_rows = []
     for name, path, floating, options in robots():
         nu, st, ratio, load = robot_rows(path, floating, options, budget, repeats)
@@ -186,8 +193,9 @@ def main():
             text = f"{st[key]['median_us']:.2f}"
             return text + (f" ({ratio[(key, against)]['median']:.2f}x)" if against else "")
         print(f"| {name}{' floating' if floating else ''} | {nu} | {us('fd', 'aba')} | "
-              f"{us('fd_low', 'aba')} | {us('aba')} | {us('id', 'rnea')} | {us('rnea')} | "
-              f"{us('M', 'crba')} | {us('crba')} | {load[0] * 1e3:.1f} / "
+              f"{us('fd_low', 'aba')} | {us('aba')} | {us('id', 'rnea')} | "
+              f"{us('id_low', 'rnea')} | {us('id_dict', 'rnea')} | {us('rnea')} | "
+              f"{us('M', 'crba')} | {us('M_low', 'crba')} | {us('crba')} | {load[0] * 1e3:.1f} / "
               f"{load[1] * 1e3:.2f} |", flush=True)
     print("\nReactions (issue 25, item 8): every joint's wrench, against Pinocchio's aba + "
           "rnea\n")

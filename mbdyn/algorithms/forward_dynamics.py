@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError
+from ..kernels import entries
 from ..kernels import packed as kp
 from .loop_newton_euler import loop_newton_euler
 
@@ -19,6 +20,9 @@ from .loop_newton_euler import loop_newton_euler
 #: textbook writes it, assembled dense and solved by LU
 METHODS = ("jourdain", "articulated", "newton-euler", "newton-euler-dense")
 
+
+#: the compiled entry of each per-call route
+FORWARD = {"jourdain": entries.jourdain_forward, "articulated": entries.articulated_forward}
 
 #: "auto" takes the articulated-body route from this many free speeds on (below it the
 #: mass matrix and its Cholesky factor are as cheap or cheaper: at 4 speeds the two cost
@@ -40,28 +44,40 @@ def forward_dynamics(model, q, u, t=0.0, method="auto"):
     if model._con is not None and method in ("newton-euler", "newton-euler-dense"):
         return loop_newton_euler(model, q, u, t)[0]
     if method in ("jourdain", "articulated"):
-        q, u = model._state(q, u)
-        if model._python_inputs:
-            model._fill_inputs(q, u, t)
-        if method == "jourdain":
-            kernel = model._jourdain_kernel
-            if kernel is None:                    # its arrays not yet allocated
-                model._full_workspace()
-                kernel = model._jourdain_kernel
-        else:
-            kernel = kp.articulated_accelerations_packed
-        try:
-            pivot = kernel(*model._packed, q, u)
-        except ZeroDivisionError:
-            raise model._division_by_zero(q, t) from None
-        if pivot >= 0:
-            model._raise_singular(q, t, pivot)
-        if pivot == -2:
-            model._check_finite(q, u, t, model._ud, "the accelerations")
-        return model._ud.copy()
+        return _accelerations(model, q, u, t, method)
     if method in ("newton-euler", "newton-euler-dense"):
         return model._newton_euler(q, u, t, dense=method == "newton-euler-dense")[:model.nu]
     raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")
+
+
+def _accelerations(model, q, u, t, method):
+    """``u'`` by one compiled entry (``kernels.entries``) into a new array: float64 arrays
+    as they come, anything else converted and checked first."""
+    if method == "jourdain" and model._jourdain_kernel is None:
+        model._full_workspace()                  # its arrays not yet allocated
+    call = entries.entry(FORWARD[method], entries.FORWARD_SIGNATURE)
+    out = np.empty(model.nu)
+    fb, ib, _ = model._packed
+    status = entries.WRONG_SIZE
+    if not model._python_inputs:
+        try:
+            status = call(fb, ib, q, u, out)
+        except (TypeError, ZeroDivisionError):
+            pass
+    if status == entries.WRONG_SIZE:             # convert, check, say what is wrong
+        q, u = model._state(q, u)
+        q, u = np.require(q, float, "CW"), np.require(u, float, "CW")  # the entry's types
+        if model._python_inputs:
+            model._fill_inputs(q, u, t)
+        try:
+            status = call(fb, ib, q, u, out)
+        except ZeroDivisionError:
+            raise model._division_by_zero(q, t) from None
+    if status >= 0:
+        model._raise_singular(q, t, status)
+    if status == -2:
+        model._check_finite(q, u, t, out, "the accelerations")
+    return out
 
 
 def formulation(model, method="auto"):

@@ -10,6 +10,7 @@ import numpy as np
 
 from ..errors import NonFiniteError
 from ..kernels import dynamics as kd
+from ..kernels import entries
 from ..kernels import packed as kp
 
 
@@ -25,8 +26,32 @@ def jourdain_terms(model, q, u, t):
 
 
 def mass_matrix(model, q, t=0.0):
-    """The Jourdain mass matrix ``M(q)`` (nu x nu, symmetric)."""
-    return model._mass_matrix(q, t, model._jourdain_packed)
+    """The Jourdain mass matrix ``M(q)`` (nu x nu, symmetric), by composite rigid bodies
+    in one compiled call (``kernels.inverse``: each joint's motion subspace, no full
+    Jacobians, O(n depth))."""
+    M = np.empty((model.nu, model.nu))
+    fb, ib, _ = model._packed
+    call = entries.entry(entries.mass_matrix, entries.MASS_MATRIX_SIGNATURE)
+    status = entries.WRONG_SIZE
+    if not model._python_inputs:
+        try:                                 # a float64 array as it comes: no conversion
+            status = call(fb, ib, q, M)
+        except (TypeError, ZeroDivisionError):
+            pass
+    u = np.zeros(model.nu)
+    if status == entries.WRONG_SIZE:         # convert, check, say what is wrong
+        q = np.require(model._state(q, u)[0], float, "CW")  # the entry's type
+        if model._python_inputs:             # the drives' coordinates at t
+            model._fill_inputs(q, u, t)
+        try:
+            status = call(fb, ib, q, M)
+        except ZeroDivisionError:
+            raise model._division_by_zero(q, t) from None
+    if status == -2:
+        model._require_finite(q, u, t)
+        raise NonFiniteError(f"model {model.name!r}, t={t:.6g}: the mass matrix came out "
+                             "non-finite (check masses, inertias and drives)")
+    return M
 
 
 def mass_matrix_by(model, q, t, terms):

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..kernels import dynamics as kd
+from ..kernels import entries
 from .forward_dynamics import ARTICULATED_FROM, METHODS
 from .loop_newton_euler import loop_newton_euler_reactions
 from .newton_euler import tree_order
@@ -79,36 +80,77 @@ def reaction_array(model, q, u, t=0.0, frame="world"):
     return w
 
 
-def inverse_dynamics(model, q, u, u_dot, t=0.0, frame="world"):
-    """The efforts and reactions that make the motion ``(q, u, u')``: returns
-    ``(efforts, reactions)`` -- ``efforts`` ``{speed name: generalized force}`` the
-    actuators must add on each free speed, ``Q = M u' - f`` (a torque on a revolute
-    joint's speed, a force on a prismatic one), and ``reactions`` ``{joint: (F, M)}``
-    as ``Model.reactions`` gives them, the joints transmitting those efforts too."""
-    q, u = model._state(q, u)
+def _rates(model, u_dot):
+    """``u'`` as a contiguous float array of the model's speeds, checked."""
     try:
-        ud = np.asarray(u_dot, dtype=float)
+        ud = np.require(u_dot, float, "CW")
     except (TypeError, ValueError):
         raise ModelError(f"model {model.name!r}: u_dot must be {model.nu} numbers, got "
                          f"{u_dot!r}") from None
     if ud.shape != (model.nu,):
         raise ModelError(f"model {model.name!r}: u_dot needs {model.nu} values, got "
                          f"{ud.size}")
-    M = model.mass_matrix(q, t)
-    f = model.forcing(q, u, t)
-    Q = M @ ud - f
-    model._kinematics_kernel(q, u, t, ud)
-    model._drop_velocity_products()
-    w = np.empty((model.n_frames, 6))
-    kd.joint_wrenches(model._mass, model._com, model._inertia, model._parent, model._R,
-                      model._r, model._w, model._alpha, model._a, model._F, model._N, w)
-    reactions = {name: (w[i, :3].copy(), w[i, 3:].copy())
-                 for i, name in enumerate(model.joints)}
-    if frame == "child":
-        reactions = {name: (model._R[i].T @ fo, model._R[i].T @ mo)
-                     for i, (name, (fo, mo)) in enumerate(reactions.items())}
-    elif frame != "world":
+    return ud
+
+
+def effort_array(model, q, u, u_dot, t=0.0):
+    """The generalized forces the actuators must add on each free speed to make the
+    motion ``(q, u, u')``: ``Q = M u' - f``, one array in ``Model.speeds`` order (a torque
+    on a revolute joint's speed, a force on a prismatic one) -- ``inverse_dynamics``'s
+    efforts without its dictionaries, by the recursive Newton-Euler algorithm in one
+    compiled call (O(n); a closed mechanism by ``M u' - f`` of its tree)."""
+    tau = np.empty(model.nu)
+    fb, ib, _ = model._packed
+    call = entries.entry(entries.inverse_dynamics, entries.INVERSE_SIGNATURE)
+    status = entries.WRONG_SIZE
+    if model._con is None and not model._python_inputs:
+        try:                             # float64 arrays as they come: no conversion
+            status = call(fb, ib, q, u, u_dot, tau)
+        except (TypeError, ZeroDivisionError):
+            pass
+    if status == entries.WRONG_SIZE:     # convert, check, say what is wrong
+        q, u = model._state(q, u)
+        ud = _rates(model, u_dot)
+        if model._con is not None:
+            return model.mass_matrix(q, t) @ ud - model.forcing(q, u, t)
+        q, u = np.require(q, float, "CW"), np.require(u, float, "CW")  # the entry's types
+        if model._python_inputs:
+            model._fill_inputs(q, u, t)
+        try:
+            status = call(fb, ib, q, u, ud, tau)
+        except ZeroDivisionError:
+            raise model._division_by_zero(q, t) from None
+    if status == -2:
+        model._check_finite(q, u, t, tau, "the inverse dynamics")
+    return tau
+
+
+def inverse_dynamics(model, q, u, u_dot, t=0.0, frame="world"):
+    """The efforts and reactions that make the motion ``(q, u, u')``: returns
+    ``(efforts, reactions)`` -- ``efforts`` ``{speed name: generalized force}`` the
+    actuators must add on each free speed, ``Q = M u' - f`` (a torque on a revolute
+    joint's speed, a force on a prismatic one), and ``reactions`` ``{joint: (F, M)}``
+    as ``Model.reactions`` gives them, the joints transmitting those efforts too.
+    ``effort_array`` gives the efforts alone as an array, faster."""
+    if frame not in ("world", "child"):
         raise ModelError(f"unknown frame {frame!r} for reactions; use 'world' or 'child'")
+    Q = effort_array(model, q, u, u_dot, t)
+    if model._con is None:
+        w = model._W                     # the joint wrenches of that motion
+    else:
+        q, u = model._state(q, u)
+        model._kinematics_kernel(q, u, t, _rates(model, u_dot))
+        model._drop_velocity_products()
+        w = np.empty((model.n_frames, 6))
+        kd.joint_wrenches(model._mass, model._com, model._inertia, model._parent, model._R,
+                          model._r, model._w, model._alpha, model._a, model._F, model._N, w)
+    R = model._R
+    if frame == "child":
+        reactions = {name: (R[i].T @ w[i, :3], R[i].T @ w[i, 3:])
+                     for i, name in enumerate(model.joints)}
+    else:
+        reactions = {name: (w[i, :3].copy(), w[i, 3:].copy())
+                     for i, name in enumerate(model.joints)}
     return dict(zip(model.speeds, Q.tolist())), reactions
 
 

@@ -17,34 +17,19 @@ import numpy as np
 from numba import njit
 
 from ..errors import ModelError
+from ..kernels import entries
 from ..kernels import packed as kp
+from ..kernels.entries import FORWARD_SIGNATURE as SIGNATURE
+from ..kernels.entries import WRONG_SIZE
+from ..kernels.entries import articulated_forward as _articulated_forward
+from ..kernels.entries import jourdain_forward as _jourdain_forward
+from ..kernels.entries import entry as _entry
 from ..kernels.views import UNCOUNTED, c_view
 
 _ARRAY, _F64 = np.ndarray, np.dtype(np.float64)
 
-#: the one type the entry points accept: no other is compiled, so that a wrong array is
-#: refused by numba's dispatcher (a TypeError) instead of being compiled for
-SIGNATURE = "int64(float64[::1], int64[::1], float64[::1], float64[::1], float64[::1])"
-#: a size that does not fit the model
-WRONG_SIZE = -3
-
-
 # The integer buffer ``ib`` starts with the offset table (``packed.pack``) and stands for it:
 # one array less for numba to type and unbox at every call.
-
-@njit(inline="always", **UNCOUNTED)
-def _forward(accelerations, fb, ib, q, u, out):
-    """``accelerations`` (a packed kernel) at ``q``, ``u``, its ``u'`` copied into ``out``
-    (which may be the workspace's own ``ud``) in compiled code."""
-    nu = ib[1]
-    if q.shape[0] != ib[7] or u.shape[0] != nu or out.shape[0] != nu:
-        return WRONG_SIZE
-    status = accelerations(fb, ib, ib, q, u)
-    ud = c_view(fb, ib[kp.UD], (nu,))
-    for k in range(nu):
-        out[k] = ud[k]
-    return status
-
 
 @njit(inline="always", **UNCOUNTED)
 def _state(derivative, fb, ib, y, ydot):
@@ -54,16 +39,8 @@ def _state(derivative, fb, ib, y, ydot):
     return derivative(fb, ib, ib, y, ydot)
 
 
-def _jourdain_forward(fb, ib, q, u, out):
-    return _forward(kp.jourdain_accelerations_packed, fb, ib, q, u, out)
-
-
 def _jourdain_state(fb, ib, y, ydot):
     return _state(kp.state_derivative_packed, fb, ib, y, ydot)
-
-
-def _articulated_forward(fb, ib, q, u, out):
-    return _forward(kp.articulated_accelerations_packed, fb, ib, q, u, out)
 
 
 def _articulated_state(fb, ib, y, ydot):
@@ -92,15 +69,6 @@ ROUTES = {"jourdain": (_jourdain_forward, _jourdain_state),
           "articulated": (_articulated_forward, _articulated_state)}
 #: the signatures of the two entry points
 SIGNATURES = (SIGNATURE, "int64(float64[::1], int64[::1], float64[::1], float64[::1])")
-_COMPILED = {}
-
-
-def _entry(function, signature):
-    """``function`` compiled for ``signature`` only, on first use (``import`` compiles
-    nothing); a call with any other argument types raises TypeError at once."""
-    if function not in _COMPILED:
-        _COMPILED[function] = njit(signature, **UNCOUNTED)(function)
-    return _COMPILED[function]
 
 
 class LowLevel:
@@ -122,6 +90,7 @@ class LowLevel:
         self._nq, self._nu = model.nq, model.nu
         self._ydot = np.empty(model.nq + model.nu)
         self._wrenches = np.empty((model.n_frames, 6))
+        self._tau, self._M = np.empty(model.nu), np.empty((model.nu, model.nu))
         self.forward_dynamics = self._bind_forward_dynamics()
 
     def _bind_forward_dynamics(self):
@@ -195,22 +164,66 @@ class LowLevel:
             model.reaction_array(q, u, t)          # raises the precise error
         return out
 
-    def _refuse(self, **arrays):
+    def inverse_dynamics(self, q, u, u_dot, t=0.0, out=None):
+        """The generalized forces ``M u' - f`` on the free speeds that make the motion
+        ``(q, u, u')`` (``Model.effort_array``), by the recursive Newton-Euler algorithm in
+        one compiled call; a workspace array unless ``out`` is given."""
+        model = self.model
+        if model._con is not None:
+            raise ModelError(f"model {model.name!r} has closed loops: use "
+                             "model.inverse_dynamics(q, u, u_dot, t)")
+        if self._inputs:
+            self._refuse(q=q, u=u)
+            model._fill_inputs(q, u, t)
+        if out is None:
+            out = self._tau
+        try:
+            status = _entry(entries.inverse_dynamics, entries.INVERSE_SIGNATURE)(
+                self._fb, self._ib, q, u, u_dot, out)
+        except TypeError:
+            status = WRONG_SIZE
+        if status != -1:
+            self._refuse(q=q, u=u, u_dot=u_dot, out=out)
+            model.effort_array(q, u, u_dot, t)           # raises the precise error
+        return out
+
+    def mass_matrix(self, q, t=0.0, out=None):
+        """The mass matrix ``M(q)`` (nu x nu) by composite rigid bodies in one compiled
+        call; a workspace array unless ``out`` is given."""
+        model = self.model
+        if self._inputs:
+            self._refuse(q=q)
+            model._fill_inputs(q, np.zeros(self._nu), t)
+        if out is None:
+            out = self._M
+        try:
+            status = _entry(entries.mass_matrix, entries.MASS_MATRIX_SIGNATURE)(
+                self._fb, self._ib, q, out)
+        except TypeError:
+            status = WRONG_SIZE
+        if status != -1:
+            self._refuse(square=True, q=q, out=out)
+            model.mass_matrix(q, t)                       # raises the precise error
+        return out
+
+    def _refuse(self, square=False, **arrays):
         """Raise, naming the first of ``arrays`` that is not a C-contiguous float64 array of
-        the model's size; return if they all are."""
-        sizes = {"q": self._nq, "u": self._nu, "y": self._nq + self._nu,
-                 "out": self._nq + self._nu if "y" in arrays else self._nu}
+        the model's size (``out`` nu x nu with ``square``); return if they all are."""
+        nq, nu = self._nq, self._nu
+        sizes = {"q": (nq,), "u": (nu,), "y": (nq + nu,), "u_dot": (nu,),
+                 "out": (nu, nu) if square else ((nq + nu,) if "y" in arrays else (nu,))}
         for name, a in arrays.items():
             if not (isinstance(a, np.ndarray) and a.dtype == np.float64
-                    and a.shape == (sizes[name],) and a.flags.c_contiguous
+                    and a.shape == sizes[name] and a.flags.c_contiguous
                     and a.flags.writeable):
                 got = type(a).__name__
                 if isinstance(a, np.ndarray):
                     kind = ("" if a.flags.c_contiguous else "non-contiguous ") + (
                         "" if a.flags.writeable else "read-only ")
                     got = f"{kind}{a.dtype} array of shape {a.shape}"
+                shape = sizes[name] if len(sizes[name]) > 1 else f"({sizes[name][0]},)"
                 raise ModelError(f"lowlevel: {name} must be a contiguous, writable float64 "
-                                 f"numpy array of shape ({sizes[name]},), got {got}; convert "
+                                 f"numpy array of shape {shape}, got {got}; convert "
                                  "it once with np.array(..., dtype=float) outside the loop")
 
     def _fail(self, q, u, t):

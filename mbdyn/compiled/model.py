@@ -191,6 +191,7 @@ class Model:
     reactions = joint_reactions.reactions
     reaction_array = joint_reactions.reaction_array
     inverse_dynamics = joint_reactions.inverse_dynamics
+    effort_array = joint_reactions.effort_array
     inverse_dynamics_along = joint_reactions.inverse_dynamics_along
     drive_efforts = joint_reactions.drive_efforts
     energy = energies.energy

@@ -1,0 +1,79 @@
+"""Entry points compiled for one signature: the calls from Python that must cost little.
+
+numba checks every argument of a compiled function at each call; a function compiled for
+one explicit signature (contiguous, writable float64 arrays and the packed model's integer
+buffer) does that fastest and refuses any other type at once (``TypeError``) instead of
+compiling for it.  Each entry checks the sizes before it touches the buffers (returns
+``WRONG_SIZE``) and returns the kernel's status: -1 on success, a speed's column where a
+degree of freedom has no inertia, -2 for a non-finite result.
+
+The integer buffer ``ib`` starts with the offset table (``packed.pack``) and stands for it:
+one array less to type and unbox at every call.
+"""
+from numba import njit
+
+from . import inverse as ki
+from . import packed as kp
+from .views import UNCOUNTED, c_view
+
+#: a size that does not fit the model
+WRONG_SIZE = -3
+
+#: ``(fb, ib, q, u, out)``
+FORWARD_SIGNATURE = "int64(float64[::1], int64[::1], float64[::1], float64[::1], float64[::1])"
+#: ``(fb, ib, q, u, u_dot, tau)``
+INVERSE_SIGNATURE = ("int64(float64[::1], int64[::1], float64[::1], float64[::1], "
+                     "float64[::1], float64[::1])")
+#: ``(fb, ib, q, M)``
+MASS_MATRIX_SIGNATURE = "int64(float64[::1], int64[::1], float64[::1], float64[:, ::1])"
+
+_COMPILED = {}
+
+
+def entry(function, signature):
+    """``function`` compiled for ``signature`` only, on first use (``import`` compiles
+    nothing)."""
+    if function not in _COMPILED:
+        _COMPILED[function] = njit(signature, **UNCOUNTED)(function)
+    return _COMPILED[function]
+
+
+def inverse_dynamics(fb, ib, q, u, ud, tau):
+    """Generalized forces ``tau = M u' - f`` on the free speeds, and the joint wrenches in
+    the packed ``W`` view (``inverse.inverse_dynamics_packed``)."""
+    nu = ib[1]
+    if q.shape[0] != ib[7] or u.shape[0] != nu or ud.shape[0] != nu or tau.shape[0] != nu:
+        return WRONG_SIZE
+    return ki.inverse_dynamics_packed(fb, ib, ib, q, u, ud, tau)
+
+
+def mass_matrix(fb, ib, q, M):
+    """The mass matrix at ``q`` into ``M`` (``inverse.mass_matrix_packed``)."""
+    nu = ib[1]
+    if q.shape[0] != ib[7] or M.shape[0] != nu or M.shape[1] != nu:
+        return WRONG_SIZE
+    return ki.mass_matrix_packed(fb, ib, ib, q, M)
+
+
+@njit(inline="always", **UNCOUNTED)
+def _forward(accelerations, fb, ib, q, u, out):
+    """``accelerations`` (a packed kernel) at ``q``, ``u``, its ``u'`` copied into ``out``
+    (which may be the workspace's own ``ud``) in compiled code."""
+    nu = ib[1]
+    if q.shape[0] != ib[7] or u.shape[0] != nu or out.shape[0] != nu:
+        return WRONG_SIZE
+    status = accelerations(fb, ib, ib, q, u)
+    ud = c_view(fb, ib[kp.UD], (nu,))
+    for k in range(nu):
+        out[k] = ud[k]
+    return status
+
+
+def jourdain_forward(fb, ib, q, u, out):
+    """Forward dynamics ``u'`` into ``out`` by ``M u' = f`` (Cholesky)."""
+    return _forward(kp.jourdain_accelerations_packed, fb, ib, q, u, out)
+
+
+def articulated_forward(fb, ib, q, u, out):
+    """Forward dynamics ``u'`` into ``out`` by the articulated-body algorithm."""
+    return _forward(kp.articulated_accelerations_packed, fb, ib, q, u, out)
