@@ -432,3 +432,32 @@ def test_tree_universal_and_cylindrical_are_two_joints_through_a_cross():
     assert "u.cross" in m.frames
     with pytest.raises(mb.ModelError, match="not perpendicular"):
         s.add_joint("bad", "universal", "c", "ground", axis="z", axis2=(1, 0, 1))
+
+
+def test_run_solve_on_the_chosen_rows_equals_the_svd_solve():
+    """During a run the accelerations are solved on the rows the last projection chose
+    (``kernels.constrained._chosen_rows_solve``: ``S`` of the rank's size, no pivoting);
+    they equal the minimum-norm SVD solve's.  Rows that no longer span the constraints
+    (a zero row chosen) fail its pivot test and the solve pivots again."""
+    from mbdyn.kernels.constrained import ROWS
+    for path in ("models/andrews_squeezer.toml", "models/four_bar.toml"):
+        scene = mb.load_model(path)
+        m = scene.model
+        q, u = scene.q0.copy(), scene.u0.copy()
+        reference = m.forward_dynamics(q, u)              # rank by the SVD, minimum norm
+        info = m._con[7]
+        rank = m.constraint_rank(q)[0]
+        try:
+            info[2] = rank                                # as a run holds it
+            m.project(q, u)                               # chooses the rows
+            assert info[ROWS] == rank and rank < len(m.constraint_rows)
+            fast = m.forward_dynamics(q, u)
+            assert np.abs(fast - reference).max() <= 1e-12 * np.abs(reference).max()
+            G = m.constraint_jacobian(q)
+            zero = [k for k in range(G.shape[0]) if not G[k].any()]
+            if zero:                                      # a planar loop's out-of-plane row
+                info[ROWS + 1] = zero[0]
+                again = m.forward_dynamics(q, u)
+                assert np.abs(again - reference).max() <= 1e-12 * np.abs(reference).max()
+        finally:
+            info[2] = info[ROWS] = -1.0

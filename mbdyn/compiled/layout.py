@@ -298,7 +298,8 @@ def constraints(model, loop_joints):
     """The loop joints' primitive constraints (``compiled.constraint_packing``) and their
     workspace: ``model._con = (con_int, con_data, phi, psi, G, gamma, lam, info)``, or
     None for a tree.  ``info``: rank, conditioning, the rank a run holds (-1: none), the
-    lowest rank and conditioning a run met at its steps (``kernels.constrained``)."""
+    lowest rank and conditioning a run met at its steps, then how many rows the last
+    projection chose (-1: none) and those rows (``kernels.constrained.ROWS``)."""
     model.loop_joints = tuple(j.name for j in loop_joints)
     model._loop_joint = {j.name: j for j in loop_joints}
     if not loop_joints:
@@ -312,4 +313,5 @@ def constraints(model, loop_joints):
     model.constraint_rows = labels
     model._row_joint, model._prim_joint = owners, prim_owner
     model._con = (con_int, con_data, np.zeros(m), np.zeros(m), np.zeros((m, model.nu)),
-                  np.zeros(m), np.zeros(m), np.array([0.0, 1.0, -1.0, np.inf, 1.0]))
+                  np.zeros(m), np.zeros(m),
+                  np.concatenate([[0.0, 1.0, -1.0, np.inf, 1.0, -1.0], np.zeros(m)]))

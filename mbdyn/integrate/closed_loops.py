@@ -10,6 +10,7 @@ import warnings
 import numpy as np
 
 from ..errors import ModelError, SimulationError, SingularityWarning
+from ..kernels.constrained import ROWS
 
 #: an initial state off its constraints by less than this is projected silently
 QUIET_PROJECTION = 1e-8
@@ -42,12 +43,13 @@ def closed_initial_state(model, q, u, t0):
     rank, ratio = model.constraint_rank(q, t0)
     info[2] = info[3] = rank                  # the run holds this rank (kernels.constrained)
     info[4] = ratio
+    info[ROWS] = -1.0                         # rows to solve on: the first projection's
     return q, u
 
 
 def release_rank(model):
     """After a run: evaluations decide the rank by the tolerance again."""
-    model._con[7][2] = -1.0
+    model._con[7][2] = model._con[7][ROWS] = -1.0
 
 
 def loop_report(model, result):

@@ -24,6 +24,7 @@ from .constraints import constraint_rows
 from .evaluate import jourdain_accelerations
 from .joints import coordinate_rates
 from .kinematics import walk
+from .views import UNCOUNTED, c_view
 
 #: singular values of ``Y = L^-1 G^T`` below this fraction of the largest are taken as
 #: zero (redundant constraints, or a singular configuration)
@@ -38,6 +39,10 @@ PASSAGE_TOLERANCE = 1e-6
 #: dimensionless for directions)
 PROJECTION_TOLERANCE = 1e-13
 PROJECTION_ITERATIONS = 12
+#: ``info`` (``compiled.layout.constraints``): rank, conditioning, the rank a run holds (-1:
+#: none), the lowest rank and conditioning a run met; then, from ``ROWS``, how many rows
+#: the last pivoted factorisation of a projection chose (-1: none yet) and those rows
+ROWS = 5
 
 
 @njit(cache=True)
@@ -50,6 +55,11 @@ def constrained_solve(M, L, ud, G, gamma, lam, info):
     if m == 0:
         info[0], info[1] = 0.0, 1.0
         return
+    keep = info[2]               # during a run: the rank at the last projected state
+    if keep >= 0:
+        _pivoted_solve(L, ud, G, gamma, lam, info, int(keep),
+                       np.empty(nu * m + m * m + 4 * m + nu))
+        return
     res = gamma.copy()
     for i in range(m):
         for k in range(nu):
@@ -61,10 +71,6 @@ def constrained_solve(M, L, ud, G, gamma, lam, info):
             for k in range(i):
                 s -= L[i, k] * Y[k, j]
             Y[i, j] = s / L[i, i]
-    keep = info[2]               # during a run: the rank at the last projected state
-    if keep >= 0:
-        _pivoted_solve(L, ud, Y, res, lam, info, int(keep))
-        return
     U, sv, Vt = np.linalg.svd(Y, full_matrices=False)
     top = sv[0] if sv.shape[0] else 0.0
     rank = 0
@@ -83,16 +89,16 @@ def constrained_solve(M, L, ud, G, gamma, lam, info):
         for k in range(sv.shape[0]):
             acc += Vt[k, i] * c[k]
         lam[i] = acc
-    _add_correction(L, ud, Y, lam)
+    _add_correction(L, ud, Y, lam, np.empty(nu), m)
     info[0] = rank
     info[1] = smallest
 
 
 @njit(cache=True, inline="always")
-def _add_correction(L, ud, Y, lam):
-    """``ud += M^-1 G^T lam = L^-T (Y lam)``."""
-    nu, m = Y.shape[0], Y.shape[1]
-    z = np.empty(nu)
+def _add_correction(L, ud, Y, lam, z, m):
+    """``ud += M^-1 G^T lam = L^-T (Y lam)`` over the first ``m`` columns of ``Y`` (``z``:
+    nu floats of scratch)."""
+    nu = Y.shape[0]
     for i in range(nu):
         acc = 0.0
         for j in range(m):
@@ -111,7 +117,8 @@ def _add_correction(L, ud, Y, lam):
 def _pivoted_cholesky(A, keep, perm):
     """``A`` (symmetric, positive semi-definite) factored in place by Cholesky with
     complete pivoting: at most ``keep`` pivots, none below ``PASSAGE_TOLERANCE^2`` of the
-    first (a nearly singular direction).  ``perm`` the chosen order; returns the number
+    first (a nearly singular direction).  ``perm`` the chosen order (row numbers, as floats:
+    it lives in a float scratch); returns the number
     of pivots, the rank used."""
     m = A.shape[0]
     for j in range(m):
@@ -146,12 +153,12 @@ def _pivoted_cholesky(A, keep, perm):
 
 
 @njit(cache=True, inline="always")
-def _pivoted_back(A, perm, rank, rhs, out):
+def _pivoted_back(A, perm, rank, rhs, out, x):
     """``out`` (all rows): the solution of the pivoted rows' system ``L_r L_r^T x =
-    rhs[perm[:rank]]`` at those rows, zero elsewhere."""
-    x = np.empty(rank)
+    rhs[perm[:rank]]`` at those rows, zero elsewhere (``x``: at least ``rank`` floats of
+    scratch)."""
     for i in range(rank):
-        s = rhs[perm[i]]
+        s = rhs[int(perm[i])]
         for k in range(i):
             s -= A[i, k] * x[k]
         x[i] = s / A[i, i]
@@ -163,52 +170,126 @@ def _pivoted_back(A, perm, rank, rhs, out):
     for j in range(out.shape[0]):
         out[j] = 0.0
     for i in range(rank):
-        out[perm[i]] = x[i]
+        out[int(perm[i])] = x[i]
 
 
-@njit(cache=True)
-def _pivoted_solve(L, ud, Y, res, lam, info, keep):
+@njit(**UNCOUNTED)
+def _pivoted_solve(L, ud, G, gamma, lam, info, keep, work):
     """The constrained ``ud`` during a run, whose rank ``keep`` is known: ``S = Y^T Y``
-    factored by Cholesky with complete pivoting (``_pivoted_cholesky``), and the
-    multipliers of the rows it chose solved for, the others zero.  The rows left out are
-    combinations of the rows kept, so ``u'`` is the same as by the SVD (it is unique);
-    ``lam`` is a basic solution, not the minimum-norm one (reactions are computed by
-    ``constrained_solve`` outside runs).  An SVD costs more than a small tree's whole
-    evaluation; this, a fraction of it."""
-    m = Y.shape[1]
-    A = np.empty((m, m))
+    (``L Y = G^T``) factored by Cholesky with complete pivoting (``_pivoted_cholesky``),
+    and the multipliers of the rows it chose solved for, the others zero.  The rows left
+    out are combinations of the rows kept, so ``u'`` is the same as by the SVD (it is
+    unique); ``lam`` is a basic solution, not the minimum-norm one (reactions are computed
+    by ``constrained_solve`` outside runs).  An SVD costs more than a small tree's whole
+    evaluation; this, a fraction of it.  ``work``: ``nu m + m^2 + 4 m + nu`` floats; no
+    allocation, no reference counting."""
+    m, nu = G.shape[0], G.shape[1]
+    Y, A = c_view(work, 0, (nu, m)), c_view(work, nu * m, (m, m))
+    at = nu * m + m * m
+    res, perm, x, z = (c_view(work, at, (m,)), c_view(work, at + m, (m,)),
+                       c_view(work, at + 2 * m, (m,)), c_view(work, at + 3 * m, (nu,)))
+    if keep > 0 and info[ROWS] == keep and _chosen_rows_solve(L, ud, G, gamma, lam, info,
+                                                              keep, Y, A, res, x, z):
+        return
+    for i in range(m):
+        s = gamma[i]
+        for k in range(nu):
+            s -= G[i, k] * ud[k]
+        res[i] = s
+    for j in range(m):                              # L Y = G^T, column by column
+        for i in range(nu):
+            s = G[j, i]
+            for k in range(i):
+                s -= L[i, k] * Y[k, j]
+            Y[i, j] = s / L[i, i]
+    first = 0.0
     for i in range(m):
         for j in range(i + 1):
             acc = 0.0
-            for k in range(Y.shape[0]):
+            for k in range(nu):
                 acc += Y[k, i] * Y[k, j]
             A[i, j] = acc
             A[j, i] = acc
-    perm = np.empty(m, np.int64)
-    first = 0.0
-    for i in range(m):
         first = max(first, A[i, i])
     rank = _pivoted_cholesky(A, keep, perm)
-    _pivoted_back(A, perm, rank, res, lam)
-    _add_correction(L, ud, Y, lam)
+    _pivoted_back(A, perm, rank, res, lam, x)
+    _add_correction(L, ud, Y, lam, z, m)
     info[0] = rank
     info[1] = A[rank - 1, rank - 1] / np.sqrt(first) if rank and first > 0 else 1.0
 
 
+@njit(cache=True, inline="always")
+def _chosen_rows_solve(L, ud, G, gamma, lam, info, r, Y, A, res, x, z):
+    """``_pivoted_solve`` on the ``r`` rows the last projection's factorisation chose
+    (``info[ROWS + 1:]``): the same ``u'`` (those rows span the others while the rank
+    holds), ``S`` of size ``r`` instead of ``m`` and no pivoting.  Returns False, having
+    changed nothing, when a pivot falls below ``PASSAGE_TOLERANCE^2`` of the largest
+    diagonal entry (the rows no longer independent enough: the caller pivots again)."""
+    m, nu = G.shape[0], G.shape[1]
+    for i in range(m):
+        s = gamma[i]
+        for k in range(nu):
+            s -= G[i, k] * ud[k]
+        res[i] = s
+    for j in range(r):
+        row = int(info[ROWS + 1 + j])
+        for i in range(nu):                         # L Y = G_r^T, column by column
+            s = G[row, i]
+            for k in range(i):
+                s -= L[i, k] * Y[k, j]
+            Y[i, j] = s / L[i, i]
+    first = 0.0
+    for i in range(r):
+        for j in range(i + 1):
+            acc = 0.0
+            for k in range(nu):
+                acc += Y[k, i] * Y[k, j]
+            A[i, j] = acc
+        first = max(first, A[i, i])
+    for k in range(r):                              # Cholesky, lower triangle
+        d = A[k, k]
+        for j in range(k):
+            d -= A[k, j] * A[k, j]
+        if not d > PASSAGE_TOLERANCE * PASSAGE_TOLERANCE * first:
+            return False
+        A[k, k] = np.sqrt(d)
+        for i in range(k + 1, r):
+            s = A[i, k]
+            for j in range(k):
+                s -= A[i, j] * A[k, j]
+            A[i, k] = s / A[k, k]
+    rows = info[ROWS + 1:ROWS + 1 + r]
+    _pivoted_back(A, rows, r, res, lam, x)          # the rows' multipliers, 0 elsewhere
+    _add_correction(L, ud, Y, x, z, r)
+    info[0] = r
+    info[1] = A[r - 1, r - 1] / np.sqrt(first) if first > 0 else 1.0
+    return True
+
+
 @njit(cache=True)
-def min_norm_step(G, rhs, keep, du):
+def min_norm_step(G, rhs, keep, du, info):
     """``du``: the minimum-norm solution of ``G du = rhs`` -- by ``G^T (G G^T)^+ rhs`` on
     the rows a pivoted Cholesky of ``G G^T`` keeps (``keep`` at most) during a run, by
     least squares (SVD) when the rank is not known (``keep < 0``).  Returns the last
     pivot's singular value over the first's (an estimate of ``G``'s conditioning; 1.0
-    by least squares)."""
+    by least squares).  The rows the factorisation chose are kept in ``info[ROWS:]`` for
+    the evaluations that follow (``_chosen_rows_solve``)."""
     m, nu = G.shape[0], G.shape[1]
     if keep < 0:
         x = np.linalg.lstsq(G, rhs, RANK_TOLERANCE)[0]
         for k in range(nu):
             du[k] = x[k]
         return 1.0
-    A = np.empty((m, m))
+    return _min_norm_pivoted(G, rhs, keep, du, info, np.empty(m * m + 3 * m))
+
+
+@njit(**UNCOUNTED)
+def _min_norm_pivoted(G, rhs, keep, du, info, work):
+    """``min_norm_step`` with the rank known, in ``work`` (``m^2 + 3 m`` floats)."""
+    m, nu = G.shape[0], G.shape[1]
+    A = c_view(work, 0, (m, m))
+    perm, z, x = (c_view(work, m * m, (m,)), c_view(work, m * m + m, (m,)),
+                  c_view(work, m * m + 2 * m, (m,)))
     for i in range(m):
         for j in range(i + 1):
             acc = 0.0
@@ -216,10 +297,11 @@ def min_norm_step(G, rhs, keep, du):
                 acc += G[i, k] * G[j, k]
             A[i, j] = acc
             A[j, i] = acc
-    perm = np.empty(m, np.int64)
-    z = np.empty(m)
     rank = _pivoted_cholesky(A, keep, perm)
-    _pivoted_back(A, perm, rank, rhs, z)
+    info[ROWS] = rank
+    for i in range(rank):
+        info[ROWS + 1 + i] = perm[i]
+    _pivoted_back(A, perm, rank, rhs, z, x)
     for k in range(nu):
         acc = 0.0
         for i in range(m):
@@ -330,7 +412,7 @@ def project_state(y, nq, slots, quats, free_q, free_u, tree, state, motion, con,
             break
         if steps == PROJECTION_ITERATIONS:
             return -1
-        min_norm_step(G, phi, int(info[2]), du)
+        min_norm_step(G, phi, int(info[2]), du, info)
         coordinate_rates(y[:nq], du, slots, dq)
         for k in range(nq):
             y[k] -= dq[k]
@@ -340,7 +422,7 @@ def project_state(y, nq, slots, quats, free_q, free_u, tree, state, motion, con,
             for k in range(4):
                 y[i + k] /= nrm
         steps += 1
-    ratio = min_norm_step(G, psi, int(info[2]), du)
+    ratio = min_norm_step(G, psi, int(info[2]), du, info)
     for k in range(nu):
         y[nq + k] -= du[k]
     if info[2] >= 0:                 # a run: the rank here, for the next step's stages

@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit
 
 from .joints import REVOLUTE
-from .views import c_view
+from .views import UNCOUNTED, c_view
 
 POINT, PERP, SLIDE, DIST, COUPLE = 0, 1, 2, 3, 4
 #: rows each primitive contributes
@@ -136,7 +136,7 @@ def constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
 ROW_WORK = 57
 
 
-@njit(cache=True)
+@njit(**UNCOUNTED)
 def _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
                      R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, work):
     """``constraint_rows`` in the scratch ``work`` (one allocation by the caller: the
