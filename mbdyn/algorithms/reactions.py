@@ -170,11 +170,19 @@ def inverse_dynamics_along(model, t, q, u, u_dot=None, frame="world"):
     u_dot = np.asarray(u_dot, dtype=float).reshape(len(t), model.nu)
     efforts = np.empty((len(t), model.nu))
     reactions = {j: np.empty((len(t), 6)) for j in model.joints}
-    for k in range(len(t)):
-        e, r = model.inverse_dynamics(q[k], u[k], u_dot[k], t[k], frame)
-        efforts[k] = list(e.values())
-        for j, (fo, mo) in r.items():
-            reactions[j][k, :3], reactions[j][k, 3:] = fo, mo
+    if model._con is not None or frame != "world":
+        for k in range(len(t)):
+            e, r = model.inverse_dynamics(q[k], u[k], u_dot[k], t[k], frame)
+            efforts[k] = list(e.values())
+            for j, (fo, mo) in r.items():
+                reactions[j][k, :3], reactions[j][k, 3:] = fo, mo
+        return efforts, reactions
+    wrenches = np.empty((len(t), model.n_frames, 6))
+    for k in range(len(t)):              # one compiled call a sample, no dictionaries
+        efforts[k] = effort_array(model, q[k], u[k], u_dot[k], t[k])
+        wrenches[k] = model._W
+    for i, j in enumerate(model.joints):
+        reactions[j][:] = wrenches[:, i]
     return efforts, reactions
 
 
