@@ -68,6 +68,21 @@ def _spatial_inertia(m, c, Iw, IA, i):
 
 
 @njit(cache=True, inline="always")
+def world_inertia(R, com, inertia, i, c, Iw, Y):
+    """The centre of mass ``c = R com`` from the origin and the inertia about it in world
+    axes ``Iw = R I R^T`` of frame ``i`` (``Y``, at least 3x3, is scratch: ``R I``)."""
+    for a_ in range(3):
+        c[a_] = R[i, a_, 0] * com[i, 0] + R[i, a_, 1] * com[i, 1] + R[i, a_, 2] * com[i, 2]
+        for b_ in range(3):
+            Y[a_, b_] = (R[i, a_, 0] * inertia[i, 0, b_] + R[i, a_, 1] * inertia[i, 1, b_]
+                         + R[i, a_, 2] * inertia[i, 2, b_])
+    for a_ in range(3):
+        for b_ in range(a_, 3):
+            Iw[a_, b_] = Iw[b_, a_] = (Y[a_, 0] * R[i, b_, 0] + Y[a_, 1] * R[i, b_, 1]
+                                       + Y[a_, 2] * R[i, b_, 2])
+
+
+@njit(cache=True, inline="always")
 def _add_shifted_inertia(IA, i, p, rho, Y):
     """``IA[p] += X^T IA[i] X``: a child's articulated inertia moved from its origin to its
     parent's, ``rho`` being the child's origin from the parent's.  With
@@ -182,16 +197,7 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
     rho, v6, wv = c_view(work, 39, (3,)), c_view(work, 42, (6,)), c_view(work, 48, (3,))
     # -- every body on its own: spatial inertia, velocity-product and applied wrench
     for i in range(n):
-        for a_ in range(3):
-            c[a_] = R[i, a_, 0] * com[i, 0] + R[i, a_, 1] * com[i, 1] + R[i, a_, 2] * com[i, 2]
-        for a_ in range(3):              # Iw = R I R^T: Y[:3] = R I first
-            for b_ in range(3):
-                Y[a_, b_] = (R[i, a_, 0] * inertia[i, 0, b_] + R[i, a_, 1] * inertia[i, 1, b_]
-                             + R[i, a_, 2] * inertia[i, 2, b_])
-        for a_ in range(3):
-            for b_ in range(a_, 3):
-                Iw[a_, b_] = Iw[b_, a_] = (Y[a_, 0] * R[i, b_, 0] + Y[a_, 1] * R[i, b_, 1]
-                                           + Y[a_, 2] * R[i, b_, 2])
+        world_inertia(R, com, inertia, i, c, Iw, Y)
         m_i = mass[i]
         _spatial_inertia(m_i, c, Iw, IA, i)
         wi = wv

@@ -191,26 +191,9 @@ def _pivoted_solve(L, ud, G, gamma, lam, info, keep, work):
     if keep > 0 and info[ROWS] == keep and _chosen_rows_solve(L, ud, G, gamma, lam, info,
                                                               keep, Y, A, res, x, z):
         return
-    for i in range(m):
-        s = gamma[i]
-        for k in range(nu):
-            s -= G[i, k] * ud[k]
-        res[i] = s
-    for j in range(m):                              # L Y = G^T, column by column
-        for i in range(nu):
-            s = G[j, i]
-            for k in range(i):
-                s -= L[i, k] * Y[k, j]
-            Y[i, j] = s / L[i, i]
-    first = 0.0
-    for i in range(m):
-        for j in range(i + 1):
-            acc = 0.0
-            for k in range(nu):
-                acc += Y[k, i] * Y[k, j]
-            A[i, j] = acc
-            A[j, i] = acc
-        first = max(first, A[i, i])
+    for j in range(m):
+        perm[j] = j
+    first = _schur_rows(L, ud, G, gamma, perm, m, Y, A, res)
     rank = _pivoted_cholesky(A, keep, perm)
     _pivoted_back(A, perm, rank, res, lam, x)
     _add_correction(L, ud, Y, lam, z, m)
@@ -219,21 +202,19 @@ def _pivoted_solve(L, ud, G, gamma, lam, info, keep, work):
 
 
 @njit(cache=True, inline="always")
-def _chosen_rows_solve(L, ud, G, gamma, lam, info, r, Y, A, res, x, z):
-    """``_pivoted_solve`` on the ``r`` rows the last projection's factorisation chose
-    (``info[ROWS + 1:]``): the same ``u'`` (those rows span the others while the rank
-    holds), ``S`` of size ``r`` instead of ``m`` and no pivoting.  Returns False, having
-    changed nothing, when a pivot falls below ``PASSAGE_TOLERANCE^2`` of the largest
-    diagonal entry (the rows no longer independent enough: the caller pivots again)."""
+def _schur_rows(L, ud, G, gamma, rows, r, Y, A, res):
+    """The residual ``res = gamma - G ud`` (every row); for the rows ``rows[:r]`` (row
+    numbers, as floats) ``Y = L^-1 G_r^T`` and ``A = Y^T Y`` (both triangles), the Schur
+    complement ``G_r M^-1 G_r^T``.  Returns ``A``'s largest diagonal entry."""
     m, nu = G.shape[0], G.shape[1]
     for i in range(m):
         s = gamma[i]
         for k in range(nu):
             s -= G[i, k] * ud[k]
         res[i] = s
-    for j in range(r):
-        row = int(info[ROWS + 1 + j])
-        for i in range(nu):                         # L Y = G_r^T, column by column
+    for j in range(r):                              # L Y = G_r^T, column by column
+        row = int(rows[j])
+        for i in range(nu):
             s = G[row, i]
             for k in range(i):
                 s -= L[i, k] * Y[k, j]
@@ -245,7 +226,20 @@ def _chosen_rows_solve(L, ud, G, gamma, lam, info, r, Y, A, res, x, z):
             for k in range(nu):
                 acc += Y[k, i] * Y[k, j]
             A[i, j] = acc
+            A[j, i] = acc
         first = max(first, A[i, i])
+    return first
+
+
+@njit(cache=True, inline="always")
+def _chosen_rows_solve(L, ud, G, gamma, lam, info, r, Y, A, res, x, z):
+    """``_pivoted_solve`` on the ``r`` rows the last projection's factorisation chose
+    (``info[ROWS + 1:]``): the same ``u'`` (those rows span the others while the rank
+    holds), ``S`` of size ``r`` instead of ``m`` and no pivoting.  Returns False, having
+    changed nothing, when a pivot falls below ``PASSAGE_TOLERANCE^2`` of the largest
+    diagonal entry (the rows no longer independent enough: the caller pivots again)."""
+    rows = info[ROWS + 1:ROWS + 1 + r]
+    first = _schur_rows(L, ud, G, gamma, rows, r, Y, A, res)
     for k in range(r):                              # Cholesky, lower triangle
         d = A[k, k]
         for j in range(k):
@@ -258,7 +252,6 @@ def _chosen_rows_solve(L, ud, G, gamma, lam, info, r, Y, A, res, x, z):
             for j in range(k):
                 s -= A[i, j] * A[k, j]
             A[i, k] = s / A[k, k]
-    rows = info[ROWS + 1:ROWS + 1 + r]
     _pivoted_back(A, rows, r, res, lam, x)          # the rows' multipliers, 0 elsewhere
     _add_correction(L, ud, Y, x, z, r)
     info[0] = r

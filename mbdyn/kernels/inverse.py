@@ -17,7 +17,7 @@ from numba import njit
 
 import numpy as np
 
-from .articulated import _add_shifted_inertia, _spatial_inertia
+from .articulated import _add_shifted_inertia, _spatial_inertia, world_inertia
 from .evaluate import drop_velocity_products, kinematics_and_loads
 from .joints import NU
 from .kinematics import walk
@@ -26,21 +26,6 @@ from .views import UNCOUNTED, c_view
 
 #: floats of scratch the two kernels need
 INVERSE_WORK = 48
-
-
-@njit(cache=True, inline="always")
-def _world_inertia(R, com, inertia, i, c, Iw, Y):
-    """The centre of mass ``c = R com`` from the origin and the inertia about it in world
-    axes ``Iw = R I R^T`` of frame ``i`` (``Y``, 3x3, is scratch)."""
-    for a_ in range(3):
-        c[a_] = R[i, a_, 0] * com[i, 0] + R[i, a_, 1] * com[i, 1] + R[i, a_, 2] * com[i, 2]
-        for b_ in range(3):
-            Y[a_, b_] = (R[i, a_, 0] * inertia[i, 0, b_] + R[i, a_, 1] * inertia[i, 1, b_]
-                         + R[i, a_, 2] * inertia[i, 2, b_])
-    for a_ in range(3):
-        for b_ in range(a_, 3):
-            Iw[a_, b_] = Iw[b_, a_] = (Y[a_, 0] * R[i, b_, 0] + Y[a_, 1] * R[i, b_, 1]
-                                       + Y[a_, 2] * R[i, b_, 2])
 
 
 @njit(**UNCOUNTED)
@@ -57,7 +42,7 @@ def recursive_newton_euler(mass, com, inertia, parent, kind, ucol, R, r, w, alph
     c, aG, t1, t2 = (c_view(work, 18, (3,)), c_view(work, 21, (3,)), c_view(work, 24, (3,)),
                      c_view(work, 27, (3,)))
     for i in range(n):               # each body's own wrench: m aG - F, about O_i
-        _world_inertia(R, com, inertia, i, c, Iw, Y)
+        world_inertia(R, com, inertia, i, c, Iw, Y)
         w0, w1, w2 = w[i, 0], w[i, 1], w[i, 2]
         al0, al1, al2 = alpha[i, 0], alpha[i, 1], alpha[i, 2]
         # aG = a + alpha x c + w x (w x c)
@@ -107,7 +92,7 @@ def composite_mass_matrix_s(mass, com, inertia, parent, kind, ucol, R, r, S, IC,
     c, rho, Fw = c_view(work, 18, (3,)), c_view(work, 21, (3,)), c_view(work, 24, (6,))
     Y6 = c_view(work, 30, (6, 3))
     for i in range(n):
-        _world_inertia(R, com, inertia, i, c, Iw, Y)
+        world_inertia(R, com, inertia, i, c, Iw, Y)
         _spatial_inertia(mass[i], c, Iw, IC, i)
     for i in range(n - 1, -1, -1):
         p = parent[i]
