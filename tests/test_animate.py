@@ -124,6 +124,20 @@ def test_html_view_in_headless_chromium(pendulum_result, tmp_path):
             assert np.abs(drawn - expected).max() < 2e-4 * half, i
         with pytest.raises(Exception, match="not in 0"):
             page.evaluate(f"window.mbdynView.goto({n})")
+        # the controls: play runs the frames on, pause holds one, the slider picks one
+        page.evaluate("window.mbdynView.goto(0)")
+        page.click("#mbdyn-play")
+        page.wait_for_timeout(400)
+        assert page.inner_text("#mbdyn-play") == "pause"
+        page.click("#mbdyn-play")
+        held = int(page.eval_on_selector("#mbdyn-slider", "e => e.value"))
+        assert 0 < held < n and page.inner_text("#mbdyn-play") == "play"
+        assert page.inner_text("#mbdyn-time") == f"t = {times[held]:.3f} s"
+        page.wait_for_timeout(200)
+        assert int(page.eval_on_selector("#mbdyn-slider", "e => e.value")) == held
+        page.eval_on_selector("#mbdyn-slider", "e => { e.value = '7'; "
+                              "e.dispatchEvent(new Event('input')); }")
+        assert page.inner_text("#mbdyn-time") == f"t = {times[7]:.3f} s"
         shot = tmp_path / "view.png"
         page.screenshot(path=str(shot))
         assert log["errors"] == [] and log["outside"] == []

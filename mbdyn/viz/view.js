@@ -117,7 +117,7 @@ function frameAt(k) {
   var a = D.arrows.length ? D.arrows[k] : [];
   for (i = 0; i < a.length; i += 6) polyline(lines(D.colors.force, 5), [scaled(a, i), scaled(a, i + 3)]);
   axisTips.forEach(function (t, n) { polyline(lines(D.axes.colors[n], 2), [axisOrigin, t]); });
-  D.tags.forEach(function (t) { marks.push({p: at(k, t.at), rgb: rgb(t.color), size: 10, shape: 1}); });
+  D.tags.forEach(function (t) { marks.push({p: at(k, t.at), rgb: rgb(t.color), size: 18, shape: 1}); });
   D.markers.forEach(function (m, n) {
     marks.push({p: com[k][n], rgb: rgb(m.color), size: 1.5 * m.size, shape: 0});
   });
