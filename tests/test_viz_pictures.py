@@ -1,6 +1,7 @@
 """Pictures users can trust: the HTML view's layout at common window sizes and its size,
 solid meshes facing outward, force elements and actuators drawn, GIF/MP4 in world axes,
 and plots grouping signals by unit and scale."""
+import sys
 import warnings
 from pathlib import Path
 
@@ -128,6 +129,14 @@ def test_a_ten_second_page_is_its_data_and_a_small_viewer(ten_second_page):
     assert out.stat().st_size < len(data) + len(script) + 5e3     # and nothing else
     # self-contained: nothing the page would fetch
     assert not re.search(r"<script[^>]+src=|<link|<img|https?://|//cdn", page)
+
+
+def test_the_html_view_needs_no_plotting_library(tmp_path, monkeypatch):
+    res = _load("double_pendulum.toml").simulate(t_end=0.2)
+    for name in ("matplotlib", "plotly"):          # any import of them now fails
+        monkeypatch.setitem(sys.modules, name, None)
+    assert res.animate(tmp_path / "v.html") == 7
+    assert "mbdyn-data" in (tmp_path / "v.html").read_text()
 
 
 def test_the_viewer_scripts_are_installed_with_the_package():
