@@ -8,8 +8,8 @@ as the literal text the user typed, never as markup, script or math:
   not escape ``</``, ``<!--`` or the line separators U+2028/9, so a string could end the
   block and open another; here ``<``, ``>``, ``&`` and those separators become ``\\uXXXX``
   escapes, which JavaScript reads back as the same characters.
-* ``markup``: text shown by a page or an SVG (plotly renders its texts as a small subset of
-  HTML): ``& < > " '`` as entities.
+  The HTML view writes no text as markup: its viewer shows every text through
+  ``textContent``.
 * ``mathtext``: text drawn by matplotlib, which reads ``$...$`` as TeX math (an unbalanced
   or unknown command there is an exception): every ``$`` escaped, so no math mode starts.
   Titles, axis and colour-bar labels, tick labels and annotations go through it; the labels
@@ -23,7 +23,6 @@ as the literal text the user typed, never as markup, script or math:
 """
 from __future__ import annotations
 
-import html
 import json
 
 _SCRIPT_ESCAPES = {"<": "\\u003c", ">": "\\u003e", "&": "\\u0026",
@@ -34,11 +33,6 @@ def script_json(value) -> str:
     """``value`` as JSON that cannot end or alter the ``<script>`` element around it."""
     text = json.dumps(value, allow_nan=False)
     return "".join(_SCRIPT_ESCAPES.get(c, c) for c in text)
-
-
-def markup(text) -> str:
-    """``text`` for HTML or SVG content or attributes: shown literally, never parsed."""
-    return html.escape(str(text), quote=True)
 
 
 def mathtext(text) -> str:

@@ -15,6 +15,8 @@ CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic"
                  "--no-first-run", "--disable-background-networking",
                  "--disable-component-update", "--disable-sync"]
 CI_REQUIRED = bool(os.environ.get("CI"))
+#: a browser without WebGL (the HTML view's 2D-canvas fallback)
+NO_WEBGL = ("--disable-3d-apis",)
 
 
 def sync_playwright():
@@ -35,13 +37,14 @@ def sync_playwright():
 
 
 @contextlib.contextmanager
-def page(viewport=(900, 700)):
-    """A page of a fresh headless Chromium; yields ``(page, log)`` where ``log`` collects
-    console errors, page errors, dialogs and requests that left file://."""
+def page(viewport=(900, 700), args=()):
+    """A page of a fresh headless Chromium (``args``: more command-line switches, e.g.
+    ``NO_WEBGL``); yields ``(page, log)`` where ``log`` collects console errors, page
+    errors, dialogs and requests that left file://."""
     sp = sync_playwright()
     log = {"errors": [], "outside": [], "dialogs": []}
     with sp() as p:
-        browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS + list(args))
         try:
             pg = browser.new_page(viewport={"width": viewport[0], "height": viewport[1]})
             pg.on("console", lambda m: log["errors"].append(m.text)

@@ -644,5 +644,9 @@ def test_contact_forces_drawn_as_arrows_when_asked(tmp_path):
     assert len(view_data(run, "t", 1.0, 30, 10)["arrows"]) == 5
     assert prepare(res, res.t).arrows == []                      # not asked: none
     out = tmp_path / "rest.html"
-    res.animate(str(out), contact_forces=True)
-    assert "contact forces" in out.read_text()
+    n = res.animate(str(out), contact_forces=True)
+    import json
+    import re
+    page = json.loads(re.search(r'id="mbdyn-data">(.*?)</script>', out.read_text(),
+                                re.DOTALL).group(1))
+    assert len(page["arrows"]) == n and all(len(a) == 6 for a in page["arrows"])

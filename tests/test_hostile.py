@@ -547,7 +547,6 @@ def _nothing_ran(page, log, title):
 
 
 def test_hostile_names_run_nothing_in_the_html_view(tmp_path):
-    pytest.importorskip("plotly")
     import browser
     result = _hostile_named_result()
     out = tmp_path / "view.html"
@@ -559,8 +558,13 @@ def test_hostile_names_run_nothing_in_the_html_view(tmp_path):
         assert "PWNED" not in title
         # the names arrive as the literal text the user typed, and are shown as text
         assert page.evaluate("window.mbdynView.names") == INJECTIONS
-        assert page.evaluate("document.querySelector('.gtitle').textContent") \
+        # shown as text: the title, and each body's label beside its marker
+        assert page.evaluate("document.getElementById('mbdyn-title').textContent") \
             == INJECTIONS[0]
+        assert page.evaluate("Array.from(document.querySelectorAll('.mbdyn-label'), "
+                             "e => e.textContent)") == INJECTIONS
+        assert page.evaluate("Array.from(document.querySelectorAll('.mbdyn-label'), "
+                             "e => e.children.length)") == [0] * len(INJECTIONS)
         page.evaluate("window.mbdynView.goto(1)")
         page.wait_for_timeout(300)
         _nothing_ran(page, log, title)

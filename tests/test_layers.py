@@ -34,7 +34,7 @@ LAYERS = [
 
 #: the upward imports the design allows, each lazy (inside a function) and why
 LAZY_UPWARD = {
-    # Result.plot / Result.animate: thin methods, matplotlib and plotly load on call
+    # Result.plot / Result.animate: thin methods, matplotlib loads on call
     ("mbdyn.integrate.result", "mbdyn.viz"),
     # a sweep member is a model file: its worker reads it with the loader
     ("mbdyn.analysis.sweeps.model_file", "mbdyn.io.loader"),

@@ -59,7 +59,6 @@ def test_plot(tmp_path, capsys):
 
 
 def test_animate(tmp_path, capsys):
-    pytest.importorskip("plotly")
     out = tmp_path / "arm.html"
     assert main(["animate", str(DATA / "arm6.urdf"), "--t-end", "0.1", "--out",
                  str(out)]) == 0

@@ -161,7 +161,6 @@ def test_a_mesh_that_is_not_one_warns(tmp_path):
 
 
 def test_animate_with_mesh_path_embeds_the_mesh_once(tmp_path):
-    pytest.importorskip("plotly")
     import json
     import re
 

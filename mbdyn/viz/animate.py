@@ -52,11 +52,9 @@ def animate(result, out, speed=1.0, fps=30.0, title=None, max_frames=MAX_FRAMES,
         fps = 100.0 / max(1, round(100.0 / fps))
     times = sample_times(result, fps, speed, max_frames)
     title = title or result.model.name
-    if ext == ".html":
-        from .html import plotly_js, write_html
-        plotly_js()                       # the missing extra named before any work
     with files.replacing(out) as tmp:     # a link at ``out`` is replaced, not followed
         if ext == ".html":
+            from .html import write_html
             write_html(prepare(result, times, contact_forces), tmp, fps=fps, speed=speed,
                        title=title)
         else:

@@ -73,7 +73,9 @@ class PosedRun:
     mover (the frames, then the extra primitives), the ``drawing``, the scene's ``centre``
     and ``half``-width, the output points' positions ``points`` ``{name: (n, 3)}`` and,
     when asked, the contact forces as ``arrows``: per pose an array ``(k, 2, 3)`` of
-    segments from each touching point along its force (``Model.contact_forces``)."""
+    segments from each touching point along its force (``Model.contact_forces``); ``box``
+    the corners ``(lo, hi)`` of the box the mechanism fills over the run (its pieces and
+    the output points; the ground planes left out)."""
     model: object
     geometry: list
     drawing: dr.Drawing
@@ -82,6 +84,7 @@ class PosedRun:
     half: float
     points: dict
     arrows: list = field(default_factory=list)
+    box: tuple = None
 
 
 def _posed(model, kin):
@@ -91,16 +94,24 @@ def _posed(model, kin):
     return R, r, prims
 
 
-def _extent(d, poses, extra):
-    """``(centre, half-width)`` of a cube holding every piece at every pose."""
+def _box(d, poses, extra):
+    """``(lo, hi)``: the corners of the box (along the world axes) that holds every piece
+    at every pose, and the points ``extra``."""
     pts = [extra.reshape(-1, 3)]
     for _, R, r in poses:
         pts += [r[m] + v @ R[m].T for m, v, _, _ in d.solids]
         pts.append(np.array([dr.world(R, r, a) for _, _, ps in d.polylines for a in ps]
                             + [dr.world(R, r, a) for _, a, b in d.springs + d.dampers
                                for a in (a, b)]).reshape(-1, 3))
-    allp = np.vstack(pts) if pts else np.zeros((1, 3))
-    lo, hi = allp.min(axis=0), allp.max(axis=0)
+    allp = np.vstack(pts)
+    if not len(allp):
+        allp = np.zeros((1, 3))
+    return allp.min(axis=0), allp.max(axis=0)
+
+
+def _extent(d, poses, extra):
+    """``(centre, half-width)`` of a cube holding every piece at every pose."""
+    lo, hi = _box(d, poses, extra)
     return 0.5 * (lo + hi), max(0.5 * float((hi - lo).max()), 1e-3) * 1.1
 
 
@@ -125,7 +136,8 @@ def prepare(result, times, contact_forces=False):
     for name, corners, _ in d.planes:         # a plane far from the motion stays in view
         centre, half = _extent(d, [], np.vstack([extra, corners.mean(axis=0)[None],
                                                  centre + half / 1.1, centre - half / 1.1]))
-    return PosedRun(model, geometry, d, poses, centre, half, points, arrows(forces, half))
+    return PosedRun(model, geometry, d, poses, centre, half, points, arrows(forces, half),
+                    _box(d, poses, extra))
 
 
 #: the longest contact-force arrow, in the scene's half-width

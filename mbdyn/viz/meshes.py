@@ -4,7 +4,8 @@ A mesh is ``(vertices (n, 3), faces (m, 3) int)``; every face is ordered counter
 seen from outside, so ``(v1 - v0) x (v2 - v0)`` is its outward normal (the tests check this
 on every shape).  Shapes are those of ``mbdyn.elements.bodies.make_shape`` (sphere, box,
 cylinder, disk, rod), in body axes.  ``shade`` gives each face a Lambert shade for
-matplotlib, which has no lighting of its own; the HTML view lets plotly light the meshes.
+matplotlib, which has no lighting of its own; the HTML view's viewer lights the meshes
+(``view_gl.js``, ``view_2d.js``: the same headlight Lambert term and ambient).
 ``primitive_mesh`` builds the mesh of a ``(kind, pose, size)`` primitive in world axes: the
 hook through which other elements (contact shapes) add solids to a picture.
 """
