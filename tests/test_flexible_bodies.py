@@ -254,7 +254,11 @@ def test_what_attaches_to_a_flexible_body_in_this_step():
     s2.add_body("shaft", flexible={"beam": STEEL, "modes": 2})
     s2.add_joint("pin", "revolute", "ground", "shaft", axis="y")
     s2.add_load("push", "shaft", force=(0, 0, 1), point=(1, 0, 0))
-    with pytest.raises(ModelError, match="load 'push'.*flexible body 'shaft'"):
+    s2.compile()                                      # loads at nodes are there
+    s2.add_force("floor", "contact", body="shaft", center=(1, 0, 0), radius=0.01,
+                 stiffness=1e5)
+    with pytest.raises(ModelError, match="force 'floor'.*contact at the flexible body "
+                                         "'shaft' is not there yet"):
         s2.compile()
     with pytest.raises(ModelError, match="must be an identifier"):
         mb.System("c").add_body("my shaft", flexible={"beam": STEEL, "modes": 2})

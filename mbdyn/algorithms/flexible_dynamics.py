@@ -26,8 +26,8 @@ import numpy as np
 
 from ..errors import ModelError, NonFiniteError, SingularMassMatrixError
 from ..flexible.invariants import floating_frame_mass_matrix, quadratic_velocity_vector
+from .flexible_forces import body_map, generalized_forces
 from .flexible_forces import energies as _element_energies
-from .flexible_forces import generalized_forces
 
 
 def split(model, q, u):
@@ -49,19 +49,6 @@ def body_matrix(fb, eta):
     Mb = floating_frame_mass_matrix(fb.invariants, eta)
     Mb[6:, 6:] = fb.mass
     return Mb
-
-
-def body_map(tree, fb, nu):
-    """``B`` (6 + k, nu): the part of the body's ``(v_0, omega, eta')`` (body components)
-    that the model's free speeds make, after a kinematics evaluation of the tree (the
-    drives' part is in the frame's velocity, not here)."""
-    i, nut = fb.frame, tree.nu
-    RT = tree._R[i].T
-    B = np.zeros((6 + fb.n, nu))
-    B[:3, :nut] = RT @ tree._JT[i]
-    B[3:6, :nut] = RT @ tree._JR[i]
-    B[6:, fb.u] = np.eye(fb.n)
-    return B
 
 
 def body_forces(model, fb, eta, eta_dot, omega, a_b, Mb):

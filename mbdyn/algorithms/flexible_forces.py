@@ -115,6 +115,19 @@ def _bearing_speed(model, el):
                      "parameter, or a flexible rotor's name (its spin)")
 
 
+def body_map(tree, fb, nu):
+    """``B`` (6 + k, nu): the part of the body's ``(v_0, omega, eta')`` (body components)
+    that the model's free speeds make, after a kinematics evaluation of the tree (the
+    drives' part is in the frame's velocity, not here)."""
+    i, nut = fb.frame, tree.nu
+    RT = tree._R[i].T
+    B = np.zeros((6 + fb.n, nu))
+    B[:3, :nut] = RT @ tree._JT[i]
+    B[3:6, :nut] = RT @ tree._JR[i]
+    B[6:, fb.u] = np.eye(fb.n)
+    return B
+
+
 def point_state(model, sd, q, u, jacobians=True):
     """``(p, v, R, w, JT, JR)`` of a side after a tree evaluation at ``(q, u)``: world
     position and velocity of the point, orientation and angular velocity of the frame
@@ -141,7 +154,6 @@ def point_state(model, sd, q, u, jacobians=True):
     lever = R @ xb
     theta = pt.Psi @ eta
     if jacobians:
-        from .flexible_dynamics import body_map
         B = body_map(tree, fb, nu)
         JT = R @ (B[:3] - skew(xb) @ B[3:6] + pt.Phi @ B[6:])
         JR = R @ (B[3:6] + pt.Psi @ B[6:])

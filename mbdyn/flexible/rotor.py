@@ -28,9 +28,22 @@ from .reduction import _count, _damping_ratios
 LATERAL = ("v", "w", "ry", "rz")
 
 
+def _amplitudes(beam, basis):
+    """Each mode's size: its largest lateral displacement, or tilt times the mean
+    element's length if larger.  Dividing by it makes ``eta`` a length, of the order of
+    the deflection: mass-normalised modes of a light shaft under heavy disks have
+    displacements of hundreds per unit ``eta``, tilts of tens of thousands, which numeric
+    differences and error tolerances on ``eta`` cannot meet."""
+    h = beam.length / beam.n_elements
+    shapes = basis.reshape(beam.n_nodes, 6, -1)
+    return np.maximum(np.abs(shapes[:, 1:3]).max(axis=(0, 1)),
+                      h * np.abs(shapes[:, 4:6]).max(axis=(0, 1)))
+
+
 def lateral_modes(beam, n_modes=None, f_max=None, damping=0.0):
     """The :class:`ReducedBody` of ``beam``'s free-free lateral modes (rigid ones first,
-    0 Hz), mass-normalised, with the gyroscopic matrix ``G_ee`` per unit spin; ``modes``
+    0 Hz), each scaled to a largest displacement of 1 (``_amplitudes``), with the
+    gyroscopic matrix ``G_ee`` per unit spin; ``modes``
     counts the rigid ones (a beam has four), so ``4 * n_nodes`` keeps every lateral DoF
     (no truncation)."""
     K, M = beam.stiffness_matrix(), beam.mass_matrix()
@@ -46,6 +59,7 @@ def lateral_modes(beam, n_modes=None, f_max=None, damping=0.0):
         raise ModelError("no modes kept: raise modes or f_max")
     basis = np.zeros((beam.n_dofs, count))
     basis[lat] = X[:, :count]
+    basis /= _amplitudes(beam, basis)
     Kee, Mee = basis.T @ K @ basis, basis.T @ M @ basis
     Kee, Mee = 0.5 * (Kee + Kee.T), 0.5 * (Mee + Mee.T)
     G = basis.T @ beam.gyroscopic_matrix() @ basis
