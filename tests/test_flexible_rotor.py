@@ -171,8 +171,8 @@ def test_a_wrong_bearing_convention_is_caught_by_the_ross_comparison():
 
 
 def test_campbell_of_the_model_file_finds_the_oil_whip_onset_where_ross_does():
-    """The model's 12 modes (truncated: the first frequencies within 0.3 % of the whole
-    model's): the forward mode near 254 rad/s turns unstable between 200 and 400 rad/s,
+    """The model's 16 modes (truncated: the lowest four frequencies within 0.07 % of
+    ROSS's): the forward mode near 254 rad/s turns unstable between 200 and 400 rad/s,
     where ROSS's log decrement of that mode changes sign (+0.126 to -0.299)."""
     scene = mb.load_model(MODEL)
     cb = mb.campbell(scene, "Omega", np.linspace(0, 800, 9), whirl=WHIRL)
