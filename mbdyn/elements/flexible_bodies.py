@@ -64,7 +64,7 @@ class FlexibleBody:
         return self.reduced.n_modes
 
 
-def make_flexible_body(name, spec, lumped, base=None, parameters=None):  # long: checks in order
+def make_flexible_body(name, spec, lumped, base=None, parameters=None):
     """The ``FlexibleBody`` ``name`` described by ``spec`` (this module's docstring);
     ``lumped``: the rigid part (a ``Body``: mass, com, inertia about its com) carried at
     the frame; ``base``: the directory a relative ``data`` path starts from;
