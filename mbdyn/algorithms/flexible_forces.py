@@ -184,7 +184,7 @@ def wrenches(model, pk, q, u, t, jacobians=True):
 
 
 def _load(model, pk, states, q, u, t):
-    (p, v, R, w, _, _), ld = states[0], pk.record
+    (_, v, _, w, _, _), ld = states[0], pk.record
     F, N = (np.asarray(part(t, q, u) if callable(part) else part, float)
             for part in pk.extra)
     if ld.in_body:

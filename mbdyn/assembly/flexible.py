@@ -10,10 +10,10 @@ import dataclasses
 
 import numpy as np
 
+from ..algorithms.flexible_forces import KINDS
 from ..compiled.flexible_model import FlexibleModel
 from ..elements.bodies import make_body
 from ..elements.flexible_bodies import make_flexible_body
-from ..algorithms.flexible_forces import KINDS
 from ..errors import ModelError
 from ..flexible.points import node_position
 
