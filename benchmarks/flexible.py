@@ -10,6 +10,11 @@ terms are evaluated in Python (numpy) on top of the compiled tree (docs/flexible
 "Routes and cost"); the rigid body is the compiled route.  The number of beam elements
 changes only the reduction (done once, at compile), not an evaluation: the table shows
 it.  Exudyn's ``ObjectFFRFreducedOrder`` is not compared here (see the issue's note).
+
+The second table: the flexible rotor models/jeffcott_flexible.toml (16 modes) with and
+without its bearings and unbalance load at nodes (Python, ``algorithms.flexible_forces``),
+against the rigid models/jeffcott_rotor.toml (compiled): CPU time of blocks of 200
+evaluations, interleaved, medians.
 """
 import os
 
@@ -25,7 +30,9 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 import mbdyn as mb  # noqa: E402
-from timing import per_call  # noqa: E402  (this folder)
+from timing import interleaved_cpu, per_call  # noqa: E402  (this folder)
+
+ROOT = Path(__file__).resolve().parent.parent
 
 
 def shaft(modes, elements):
@@ -58,5 +65,31 @@ def main():
         print(f"| {modes} | {elements} | {c:.1f} | {c / base:.0f} | {build:.2f} |")
 
 
+
+def node_elements(rounds=9, calls=200):
+    """Cost of loads and force elements at a flexible rotor's nodes."""
+    import statistics
+    models = {
+        "flexible rotor, 2 bearings + load at nodes": mb.load_model(
+            ROOT / "models" / "jeffcott_flexible.toml").model,
+        "flexible rotor, elements off": mb.load_model(
+            ROOT / "models" / "jeffcott_flexible.toml",
+            effects="-left_bearing,-right_bearing,-unbalance").model,
+        "rigid jeffcott_rotor.toml (compiled)": mb.load_model(
+            ROOT / "models" / "jeffcott_rotor.toml").model}
+
+    def block(m):
+        q, u = m.default_coordinates(), np.full(m.nu, 1e-3)
+        return lambda: [m.forward_dynamics(q, u, 0.1) for _ in range(calls)]
+    cpu = interleaved_cpu({k: block(m) for k, m in models.items()}, rounds)
+    med = {k: statistics.median(v) / calls * 1e6 for k, v in cpu.items()}
+    base = med["rigid jeffcott_rotor.toml (compiled)"]
+    print("\n| model | us CPU per forward_dynamics | ratio to the rigid rotor |")
+    print("|---|---|---|")
+    for k, v in med.items():
+        print(f"| {k} | {v:.1f} | {v / base:.0f} |")
+
+
 if __name__ == "__main__":
     main()
+    node_elements()

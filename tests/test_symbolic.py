@@ -123,7 +123,10 @@ def test_top_methods_agree_and_spin_drops_out():
 
 # ----------------------------------------------------------------------------- numeric
 def _model_files():
-    return sorted(MODELS.glob("*.toml")) if MODELS.is_dir() else []
+    """The model files the symbolic layer knows: not those with flexible bodies (its
+    documented limit; docs/flexible.md)."""
+    files = sorted(MODELS.glob("*.toml")) if MODELS.is_dir() else []
+    return [p for p in files if "flexible =" not in p.read_text()]
 
 
 def _closed_form(el):

@@ -26,6 +26,8 @@ import numpy as np
 
 from ..errors import ModelError, NonFiniteError, SingularMassMatrixError
 from ..flexible.invariants import floating_frame_mass_matrix, quadratic_velocity_vector
+from .flexible_forces import body_map, generalized_forces
+from .flexible_forces import energies as _element_energies
 
 
 def split(model, q, u):
@@ -49,29 +51,18 @@ def body_matrix(fb, eta):
     return Mb
 
 
-def body_map(tree, fb, nu):
-    """``B`` (6 + k, nu): the part of the body's ``(v_0, omega, eta')`` (body components)
-    that the model's free speeds make, after a kinematics evaluation of the tree (the
-    drives' part is in the frame's velocity, not here)."""
-    i, nut = fb.frame, tree.nu
-    RT = tree._R[i].T
-    B = np.zeros((6 + fb.n, nu))
-    B[:3, :nut] = RT @ tree._JT[i]
-    B[3:6, :nut] = RT @ tree._JR[i]
-    B[6:, fb.u] = np.eye(fb.n)
-    return B
-
-
 def body_forces(model, fb, eta, eta_dot, omega, a_b, Mb):
     """The body's generalized forces ``Q`` (6 + k) at the state, its frame's bias
     accelerations ``a_b = [a_0; alpha]`` (body components) moved to the right."""
     tree, inv = model.tree, fb.invariants
-    Q = (quadratic_velocity_vector(inv, eta, eta_dot, omega) if tree.gyroscopic
-         else np.zeros(6 + fb.n))
+    Q = (quadratic_velocity_vector(inv, eta, eta_dot, omega)   # zero at omega = 0
+         if tree.gyroscopic and omega.any() else np.zeros(6 + fb.n))
     g = tree._R[fb.frame].T @ tree.gravity
     Q[:3] += inv.mass * g
     Q[3:6] += np.cross(inv.first_moment + inv.modal_first_moment @ eta, g)
     Q[6:] += inv.modal_first_moment.T @ g - fb.stiffness @ eta - fb.damping @ eta_dot
+    if fb.spin:                     # a rotor's spin, its frame not spinning
+        Q[6:] -= fb.spin * (fb.gyroscopic @ eta_dot)
     if model.stiffening:
         Kg = (omega[1] ** 2 + omega[2] ** 2) * fb.centrifugal + (a_b[0] - g[0]) * fb.axial
         Q[6:] -= Kg @ eta
@@ -104,6 +95,8 @@ def terms(model, q, u, t=0.0):
         f += B.T @ body_forces(model, fb, eta, eta_dot, omega, bias, Mb)
         if model.stiffening and fb.axial.any():
             coupled.append((fb.u, np.outer(fb.axial @ eta, B[0])))
+    if model._flex_elements:
+        f += generalized_forces(model, q, u, t)
     A = M
     if coupled:
         A = M.copy()
@@ -208,6 +201,16 @@ def energy(model, q, u, t=0.0):
         c = inv.first_moment + inv.modal_first_moment @ eta
         V += -tree.gravity @ (inv.mass * tree._r[i] + R @ c) + 0.5 * eta @ fb.stiffness @ eta
     return float(T), float(V)
+
+
+def element_energies(model, q, u, t=0.0):
+    """``(V, P_nc, P_load)`` of the loads and force elements at points of flexible
+    bodies (``flexible_forces``), after a kinematics evaluation of the tree."""
+    if not model._flex_elements:
+        return 0.0, 0.0, 0.0
+    q, u = split(model, q, u)
+    model.tree._kinematics_kernel(q[:model.tree.nq], u[:model.tree.nu], t)
+    return _element_energies(model, q, u, t)
 
 
 def momentum(model, q, u, t=0.0):

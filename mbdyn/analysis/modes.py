@@ -164,12 +164,7 @@ def modes(lin, whirl=(), spin=1.0, rigid_tolerance=1e-7):
                                        positive=True)
     n = lin.n
     names = lin.names
-    index = {nm: k for k, nm in enumerate(names)}
-    for pair in whirl:
-        missing = [p for p in pair if p not in index]
-        if len(pair) != 2 or missing:
-            raise ModelError(f"whirl pair {pair!r}: give two coordinate names of the "
-                             f"linearisation ({', '.join(names)})")
+    index = _whirl_rows(lin, whirl)
     values, vectors = np.linalg.eig(lin.A)
     scale = max(np.abs(values).max(initial=0.0), 1e-300)
     out = []
@@ -223,9 +218,29 @@ def _dependent_motion(mode):
     return ", ".join(parts)
 
 
+def _whirl_rows(lin, whirl):
+    """``{name: row}``: each whirl name's displacement as a row over the linearisation's
+    coordinates: a coordinate's unit row, or a flexible body's node ``BODY.NODE.y`` /
+    ``BODY.NODE.z`` (its lateral displacement in body axes, ``model.node_row``)."""
+    names = lin.names
+    rows = {}
+    for pair in whirl:
+        for p in pair:
+            if p in names:
+                rows[p] = np.eye(len(names))[names.index(p)]
+            elif hasattr(lin.model, "node_row") and isinstance(p, str) and p.count(".") == 2:
+                rows[p] = lin.model.node_row(p, names)
+        missing = [p for p in pair if p not in rows]
+        if len(pair) != 2 or missing:
+            raise ModelError(f"whirl pair {pair!r}: give two coordinate names of the "
+                             f"linearisation ({', '.join(names)}), or a flexible body's "
+                             "node as BODY.NODE.y and BODY.NODE.z")
+    return rows
+
+
 def _turn(shape, whirl, index):
     """Sense of the orbit of a shape in the lateral planes: > 0 turning from y to z."""
-    return sum(-np.imag(np.conj(shape[index[y]]) * shape[index[z]]) for y, z in whirl)
+    return sum(-np.imag(np.conj(index[y] @ shape) * (index[z] @ shape)) for y, z in whirl)
 
 
 def _circular_pairs(out, whirl, index, spin):
@@ -243,8 +258,7 @@ def _circular_pairs(out, whirl, index, spin):
         V = np.column_stack([a.shape, b.shape])
         H = np.zeros((len(a.shape), len(a.shape)), complex)
         for y, z in whirl:
-            H[index[y], index[z]] += 0.5j
-            H[index[z], index[y]] -= 0.5j
+            H += 0.5j * (np.outer(index[y], index[z]) - np.outer(index[z], index[y]))
         _, C = eigh(V.conj().T @ H @ V, V.conj().T @ V)
         for mode, c in zip((a, b), C.T):
             shape = V @ c

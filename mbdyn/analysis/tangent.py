@@ -46,7 +46,9 @@ class Tangent:
             else:
                 self.names += list(joint.coordinates)
             x += nu
-        self.n = x
+        modal = tuple(getattr(model, "modal_coordinates", ()))   # flexible bodies' (scalar)
+        self.names += list(modal)
+        self.n = x + len(modal)
         scalar = np.ones(model.nq, bool)
         for qs, _ in self.quaternion_blocks:
             scalar[qs:qs + 4] = False

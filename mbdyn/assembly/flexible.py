@@ -1,7 +1,8 @@
 """Flexible bodies added to a ``System`` and checked across the tree at compile: their
 modal coordinates' names, their effects (``flexibility_BODY``, ``geometric_stiffening``),
-and what may attach to them in this step (joints at the frame origin; no loads, no force
-elements at points on them, no closed loops).
+and what may attach to them in this step (joints at the frame origin; loads and
+spring-dampers, bushings and bearings at their nodes, evaluated in Python by
+``algorithms.flexible_forces``; no closed loops).
 """
 from __future__ import annotations
 
@@ -9,10 +10,12 @@ import dataclasses
 
 import numpy as np
 
+from ..algorithms.flexible_forces import KINDS
 from ..compiled.flexible_model import FlexibleModel
 from ..elements.bodies import make_body
 from ..elements.flexible_bodies import make_flexible_body
 from ..errors import ModelError
+from ..flexible.points import node_position
 
 #: the global effect of every system with flexible bodies: the axial force's stiffness
 STIFFENING = "geometric_stiffening"
@@ -34,7 +37,7 @@ def add_flexible_body(system, name, mass, com, inertia, shape, flexible, base=No
         raise ModelError(f"body {name!r}: a flexible body's mass, com and inertia must be "
                          "numbers (its invariants are numeric), not expressions of "
                          f"parameters ({', '.join(lumped.symbolic)})")
-    record = make_flexible_body(name, flexible, lumped, base)
+    record = make_flexible_body(name, flexible, lumped, base, system.parameters)
     clash = system._state_names.intersection(record.coordinates + record.speeds)
     if clash:
         raise ModelError(f"body {name!r}: its modal coordinates {sorted(clash)} are already "
@@ -81,26 +84,77 @@ def flexible_on(system, order, state):
                              "joints attach to a flexible body at its frame origin only "
                              "(position = [0, 0, 0], the beam's root); joints at its other "
                              "nodes are the next step")
-    for load in system._loads.values():
-        if load.body in names:
-            raise ModelError(f"load {load.name!r}: loads on the flexible body {load.body!r} "
-                             "are not there yet (the next step: their modal forces); put it "
-                             "on another body or switch the flexibility off")
     for el in system._forces.values():
         touched = names.intersection(el.frames)
-        if touched and "joint" not in el.params:
-            raise ModelError(f"force {el.name!r}: force elements at points of the flexible "
-                             f"body {sorted(touched)[0]!r} are not there yet (the next step); "
-                             "joint forces and actuators are")
+        if touched and "joint" not in el.params and el.kind not in KINDS:
+            raise ModelError(f"force {el.name!r}: a {el.kind} at the flexible body "
+                             f"{sorted(touched)[0]!r} is not there yet; {', '.join(KINDS)}, "
+                             "loads, joint forces and actuators are")
+    for b in on:
+        _check_held(system, b)
     return on
 
 
-def flexible_model(model, on, state):
+def _check_held(system, body):
+    """A rotor's lateral modes carry its whole motion: its frame must be fixed to the
+    ground (else the frame's motion repeats the rigid modes, and the spin's gyroscopic
+    terms hold in a frame that does not turn only)."""
+    if body.reduced.method != "lateral":
+        return
+    parent, _, joint = next(iter(system.graph.in_edges(body.name, data="joint")))
+    if parent != "ground" or joint.kind != "fixed":
+        raise ModelError(f"body {body.name!r}: with reduction = \"lateral\" its modes carry "
+                         "its whole lateral motion in a frame that does not move; fix it to "
+                         f"the ground (joint {joint.name!r} is a {joint.kind} joint to "
+                         f"{parent!r}) and hold it with force elements (bearings) at its "
+                         "nodes")
+
+
+def split_elements(on, loads, forces):
+    """``(tree loads, tree forces, flexible loads, flexible forces)``: the loads and force
+    elements at points of the flexible bodies ``on`` go to ``algorithms.flexible_forces``
+    (joint forces and actuators stay in the tree)."""
+    names = {b.name for b in on}
+    flex_loads = [ld for ld in loads if ld.body in names]
+    flex_forces = [el for el in forces if "joint" not in el.params
+                   and names.intersection(el.frames)]
+    return ([ld for ld in loads if ld not in flex_loads],
+            [el for el in forces if el not in flex_forces], flex_loads, flex_forces)
+
+
+#: each force kind's (body key, point key) pairs, the body's default
+POINT_KEYS = {"spring-damper": (("body_a", "point_a"), ("body_b", "point_b")),
+              "bushing": (("body_a", "point_a"), ("body_b", "point_b")),
+              "bearing": (("body", "point"),)}
+
+
+def named_points(system, element, pairs, values):
+    """``values`` with each point given as a node's name (a string) replaced by that
+    node's position on the flexible body (body axes); ``pairs``: (body key, point key)."""
+    out = dict(values)
+    for body_key, point_key in pairs:
+        point = out.get(point_key)
+        if not isinstance(point, str):
+            continue
+        body = out.get(body_key, "ground")
+        record = system._flexible.get(body)
+        if record is None:
+            raise ModelError(f"{element}: {point_key} = {point!r} names a node, but "
+                             f"{body!r} is not a flexible body; give three numbers (its "
+                             "components)")
+        out[point_key] = node_position(record.reduced, point,
+                                       f"{element}: {point_key}").tolist()
+    return out
+
+
+def flexible_model(model, on, state, loads=(), forces=()):
     """The compiled model: ``model`` itself without flexible bodies on; else the
-    ``FlexibleModel`` over it (its tree compiled with those bodies massless)."""
+    ``FlexibleModel`` over it (its tree compiled with those bodies massless), with the
+    ``loads`` and ``forces`` at their points."""
     if not on:
         return model
-    return FlexibleModel(model, on, stiffening=state[STIFFENING])
+    return FlexibleModel(model, on, stiffening=state[STIFFENING], loads=loads,
+                         forces=forces)
 
 
 def massless(bodies, on):

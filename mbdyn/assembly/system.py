@@ -234,6 +234,8 @@ class System:
             raise ModelError(f"load {name!r}: unknown body {body!r}; loads act on bodies "
                              f"and frames added with add_body or add_frame (known: "
                              f"{', '.join(n for n in self.graph if n != GROUND)})")
+        point = flex.named_points(self, f"load {name!r}", (("body", "point"),),
+                                  {"body": body, "point": point})["point"]
         self._loads[name] = make_load(name, body, force, moment, point, frame, self.parameters)
         return name
 
@@ -255,6 +257,8 @@ class System:
             raise ModelError(f"force {name!r}: the name is already used by another force "
                              "element or load; loads and force elements share one namespace "
                              "(their names are the scene's effects)")
+        params = flex.named_points(self, f"force {name!r}", flex.POINT_KEYS.get(kind, ()),
+                                   params)
         el = make_force(name, kind, self.parameters, self.gravity, **params)
         check_force(self, el)
         self._forces[name] = el
@@ -331,15 +335,16 @@ class System:
                 inertia_tensor(b.inertia, f"body {b.name!r}")
         found = [str(w.message) for w in caught if issubclass(w.category, ModelWarning)]
         gravity = self.gravity if state["gravity"] else np.zeros(3)
-        model = Model(self.name, flex.massless(bodies, flexible), joints,
-                      [ld for ld in self._loads.values() if state[ld.name]], gravity,
+        loads, forces, flex_loads, flex_forces = flex.split_elements(
+            flexible, [ld for ld in self._loads.values() if state[ld.name]],
+            [el for el in self._forces.values() if state[el.name]])
+        model = Model(self.name, flex.massless(bodies, flexible), joints, loads, gravity,
                       warnings=found, parameters=self.parameters,
                       gravity_symbolic=self.gravity_symbolic if state["gravity"] else None,
-                      forces=[el for el in self._forces.values() if state[el.name]],
-                      effects=state, loop_joints=loop_joints,
+                      forces=forces, effects=state, loop_joints=loop_joints,
                       controllers=[c for c in self._controllers.values()
                                    if any(state[a] for a in c.actuators)])
-        model = flex.flexible_model(model, flexible, state)
+        model = flex.flexible_model(model, flexible, state, flex_loads, flex_forces)
         if check_inertia and model.nu and not loop_joints:
             _check_inertia_of_every_dof(model)
         model.loops = {j.name: loop_bodies(self, j) for j in loop_joints}

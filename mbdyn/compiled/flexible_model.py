@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..algorithms import flexible_dynamics as flex
+from ..algorithms import flexible_forces
 from ..errors import ModelError
 from .model import Model
 
@@ -27,7 +28,9 @@ class FlexPack:
     ``q`` and ``u`` of the model's state, ``n`` modes, the ``invariants`` (with the rigid
     part fixed to it), modal ``mass``, ``stiffness``, ``damping``, and the geometric
     stiffness per unit ``omega_y^2 + omega_z^2`` (``centrifugal``) and per unit
-    ``a_x - g_x`` (``axial``): zero for reduced data, which carry none."""
+    ``a_x - g_x`` (``axial``): zero for reduced data, which carry none; a rotor's
+    ``spin`` (rad/s about x, its frame not spinning) and ``gyroscopic`` ``G_ee`` (or
+    ``None``)."""
     name: str
     frame: int
     q: slice
@@ -39,6 +42,8 @@ class FlexPack:
     damping: np.ndarray
     centrifugal: np.ndarray
     axial: np.ndarray
+    spin: float = 0.0
+    gyroscopic: np.ndarray | None = None
 
 
 def pack_flexible(tree, records):
@@ -52,7 +57,8 @@ def pack_flexible(tree, records):
             rec.name, tree.frame_index(rec.name), slice(nq, nq + n), slice(nu, nu + n), n,
             rec.invariants, red.mass_matrix, red.stiffness_matrix, red.damping_matrix,
             red.geometric_stiffness.get("centrifugal", zero),
-            red.geometric_stiffness.get("axial_acceleration", zero)))
+            red.geometric_stiffness.get("axial_acceleration", zero), rec.spin,
+            red.gyroscopic))
         nq, nu = nq + n, nu + n
     return tuple(packs)
 
@@ -70,7 +76,7 @@ def _not_yet(what):
 class FlexibleModel(Model):
     """A compiled model with flexible bodies; build it with ``System.compile()``."""
 
-    def __init__(self, tree, records, stiffening=True):
+    def __init__(self, tree, records, stiffening=True, loads=(), forces=()):
         # not Model.__init__: the tree is compiled already, and read through __getattr__
         self.tree = tree
         self.name = tree.name
@@ -81,6 +87,10 @@ class FlexibleModel(Model):
         self.coordinates = tree.coordinates + sum((r.coordinates for r in records), ())
         self.speeds = tree.speeds + sum((r.speeds for r in records), ())
         self.nq, self.nu = len(self.coordinates), len(self.speeds)
+        self.modal_coordinates = self.coordinates[tree.nq:]
+        #: the joint (or flexible body) of each speed
+        self._speed_joint = list(tree._speed_joint) + [r.name for r in records
+                                                       for _ in r.speeds]
         self._coordinate_index = {c: k for k, c in enumerate(self.coordinates)}
         self._speed_index = {c: k for k, c in enumerate(self.speeds)}
         self._body = {**tree._body, **{r.name: r.rigid for r in records}}
@@ -88,6 +98,11 @@ class FlexibleModel(Model):
                             and self._body[f].has_inertia)
         self.tree_effect_example = f"flexibility_{records[0].name}"
         tree._full_workspace()        # the Jacobians and M the terms read
+        # loads and force elements at points of the flexible bodies: evaluated in Python
+        self.loads = tree.loads + tuple(ld.name for ld in loads)
+        self.forces = tree.forces + tuple(el.name for el in forces)
+        self._force_elements = tree._force_elements + tuple(forces)
+        self._flex_elements = flexible_forces.pack(self, loads, forces)
 
     def __getattr__(self, name):
         tree = self.__dict__.get("tree")
@@ -98,6 +113,24 @@ class FlexibleModel(Model):
     def __repr__(self):
         return (f"<FlexibleModel {self.name!r}: {self.n_frames} frames, flexible "
                 f"{', '.join(self.flexible_bodies)}, nq={self.nq}, nu={self.nu}>")
+
+    def node_row(self, name, names):
+        """``BODY.NODE.c`` (``c``: x, y or z): that node's displacement component (body
+        axes) as a row over the coordinates ``names`` (the modal ones' mode shapes)."""
+        body, node, comp = name.split(".")
+        if body not in self.flexible or comp not in ("x", "y", "z"):
+            raise ModelError(f"{name!r}: give BODY.NODE.c with BODY a flexible body "
+                             f"({', '.join(self.flexible_bodies)}) and c one of x, y, z")
+        rec = self.flexible[body]
+        try:
+            i = rec.reduced.node(int(node) if node.isdigit() else node)
+        except ModelError as exc:
+            raise ModelError(f"{name!r}: {exc}") from None
+        row = np.zeros(len(names))
+        for k, c in enumerate(rec.coordinates):
+            if c in names:
+                row[list(names).index(c)] = rec.reduced.modes[i, "xyz".index(comp), k]
+        return row
 
     def describe_speeds(self, speeds):
         tree = [s for s in speeds if s in self.tree._speed_index]
@@ -158,7 +191,8 @@ class FlexibleModel(Model):
         damping and geometric stiffening counted in ``P_nc`` (``modal_power``)."""
         V, P_nc, P_act = self.tree.element_power(np.asarray(q, float)[:self.tree.nq],
                                                  np.asarray(u, float)[:self.tree.nu], t)
-        return V, P_nc + flex.modal_power(self, q, u, t), P_act
+        V_f, P_f, _ = flex.element_energies(self, q, u, t)
+        return V + V_f, P_nc + P_f + flex.modal_power(self, q, u, t), P_act
 
     def u_vector(self, values=None):
         """As ``Model.u_vector``; a modal coordinate's name stands for its rate too."""
@@ -174,7 +208,8 @@ class FlexibleModel(Model):
 
     def load_power(self, q, u, t=0.0):
         return self.tree.load_power(np.asarray(q, float)[:self.tree.nq],
-                                    np.asarray(u, float)[:self.tree.nu], t)
+                                    np.asarray(u, float)[:self.tree.nu], t) + \
+            flex.element_energies(self, q, u, t)[2]
 
     forward_dynamics = flex.forward_dynamics
     state_derivative = flex.state_derivative

@@ -133,15 +133,21 @@ def _bearing(model, el, element, row, data, laws):
     if ia == ib or ia < 0:
         raise ModelError(f"{element}: the shaft body must be a body other than the "
                          "housing")
-    consts = [0.0 if isinstance(p[c], Table) else p[c] for c in BEARING_COEFFICIENTS]
+    fixed = p["speed"] in model.parameters and p["speed"] not in model._speed_index
+    if fixed:            # a spin given by a parameter: the coefficients at that speed
+        spin = float(model.parameters[p["speed"]])
+        consts = [p[c](spin) if isinstance(p[c], Table) else p[c]
+                  for c in BEARING_COEFFICIENTS]
+    else:
+        consts = [0.0 if isinstance(p[c], Table) else p[c] for c in BEARING_COEFFICIENTS]
     off = data.put(np.concatenate([p["point"], p["center"], p["e1"], p["e2"], consts,
                                    -np.ones(8)]))
     mode = kf.NO_TABLE
     for k, c in enumerate(BEARING_COEFFICIENTS):
-        if isinstance(p[c], Table):
+        if isinstance(p[c], Table) and not fixed:
             data.values[off + 20 + k] = float(data.put(p[c].block()))
             mode = p[c].mode
-    slot = -1 if p["speed"] is None else speed_slot(model, p["speed"], element)
+    slot = -1 if p["speed"] is None or fixed else speed_slot(model, p["speed"], element)
     row[:4] = [kf.BEARING, ia, ib, off]
     row[5] = mode
     row[8] = slot
@@ -179,6 +185,8 @@ def warn_outside_tables(model, t, u):
         name = el.params["speed"]
         if name in model.speeds:
             spin = np.asarray(u)[:, model.speed_index(name)]
+        elif name in model.parameters:            # a constant spin
+            spin = np.full(len(t), float(model.parameters[name]))
         else:
             drive = next((d for jn, _, _, d in model._driven
                           if jn == name or name in model._joint[jn].coordinates), None)

@@ -12,7 +12,10 @@ The description (``System.add_body(..., flexible={...})`` or a model file's
 * ``modes`` (how many modes to keep) and/or ``f_max`` (a cut-off in Hz): a beam needs
   one of them; ``reduction``: ``"craig-bampton"`` (the default: the beam clamped at the
   frame, the cantilever's modes) or ``"free-interface"``;
-* ``damping``: a modal damping ratio, or one per mode (default 0, or the data's).
+* ``damping``: a modal damping ratio, or one per mode (default 0, or the data's);
+* ``spin``: a rotor's spin speed about its x axis (rad/s; a number or a parameter's
+  name), in a frame that does not spin: ``Omega G_ee eta'`` on the modal equations
+  (``reduction = "lateral"``, ``mbdyn.flexible.rotor``; the body fixed to the ground).
 
 The body frame is the beam's root (the clamped frame of the reduction).  Mass, centre of
 mass and inertia come from the inertia invariants at ``eta = 0``, plus a rigid part
@@ -32,11 +35,13 @@ from ..errors import ModelError
 from ..flexible import (ReducedBody, beam_from_spec, craig_bampton, free_interface,
                         load_reduced_body, modal_damping)
 from ..flexible.invariants import Invariants
+from ..flexible.rotor import lateral_modes
 from ..names import identifier_problem
 from .bodies import Body, make_body, make_shape
 
-KEYS = ("beam", "data", "modes", "f_max", "reduction", "damping")
-REDUCTIONS = {"craig-bampton": craig_bampton, "free-interface": free_interface}
+KEYS = ("beam", "data", "modes", "f_max", "reduction", "damping", "spin")
+REDUCTIONS = {"craig-bampton": craig_bampton, "free-interface": free_interface,
+              "lateral": None}
 
 
 @dataclass(frozen=True, eq=False)
@@ -52,16 +57,18 @@ class FlexibleBody:
     coordinates: tuple
     speeds: tuple
     spec: dict
+    spin: float = 0.0
 
     @property
     def n_modes(self):
         return self.reduced.n_modes
 
 
-def make_flexible_body(name, spec, lumped, base=None):
+def make_flexible_body(name, spec, lumped, base=None, parameters=None):
     """The ``FlexibleBody`` ``name`` described by ``spec`` (this module's docstring);
     ``lumped``: the rigid part (a ``Body``: mass, com, inertia about its com) carried at
-    the frame; ``base``: the directory a relative ``data`` path starts from."""
+    the frame; ``base``: the directory a relative ``data`` path starts from;
+    ``parameters``: the values a ``spin`` given by name reads."""
     where = f"body {name!r}: flexible"
     problem = identifier_problem(name)
     if problem:
@@ -77,6 +84,7 @@ def make_flexible_body(name, spec, lumped, base=None):
     if ("beam" in spec) == ("data" in spec):
         raise ModelError(f"{where}: give exactly one of beam = {{...}} and data = \"file\"")
     reduced = _from_beam(spec, where) if "beam" in spec else _from_data(spec, where, base)
+    spin = _spin(spec, where, reduced, parameters or {})
     inv = _with_rigid_part(reduced.invariants, lumped)
     k = reduced.n_modes
     coords = tuple(f"{name}_m{i + 1}" for i in range(k))
@@ -88,7 +96,33 @@ def make_flexible_body(name, spec, lumped, base=None):
                                f"body {name!r}")
     rigid = dataclasses.replace(rigid_body(name, inv), shape=shape)
     return FlexibleBody(name, reduced, inv, rigid, coords, tuple(f"{c}_dot" for c in coords),
-                        dict(spec))
+                        dict(spec), spin)
+
+
+def _spin(spec, where, reduced, parameters):
+    """The spin speed (rad/s): a number, or the value of the parameter it names (a name
+    only: the text is never evaluated); only with a gyroscopic matrix (``lateral``)."""
+    value = spec.get("spin")
+    if value is None:
+        return 0.0
+    if reduced.gyroscopic is None:
+        raise ModelError(f"{where}.spin: a spinning rotor needs reduction = \"lateral\" "
+                         "(the free-free lateral modes with their gyroscopic matrix, in a "
+                         "frame that does not spin)")
+    if isinstance(value, str):
+        if value not in parameters:
+            raise ModelError(f"{where}.spin: {value!r} is not a parameter; give a number "
+                             "(rad/s) or a parameter's name"
+                             + (f" ({', '.join(parameters)})" if parameters else ""))
+        value = parameters[value]
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        value = float("nan")
+    if isinstance(spec["spin"], bool) or not math.isfinite(value):
+        raise ModelError(f"{where}.spin: must be a finite spin speed in rad/s or a "
+                         f"parameter's name, got {spec['spin']!r}")
+    return value
 
 
 def _count(spec, key, where):
@@ -115,6 +149,9 @@ def _from_beam(spec, where):
                          "cut-off in Hz) or both")
     beam = beam_from_spec(spec["beam"], key=f"{where}.beam")
     try:
+        if reduction == "lateral":
+            return lateral_modes(beam, n_modes=n_modes, f_max=f_max,
+                                 damping=spec.get("damping", 0.0))
         return REDUCTIONS[reduction](beam, interface=("root",), n_modes=n_modes, f_max=f_max,
                                      damping=spec.get("damping", 0.0))
     except ModelError as exc:

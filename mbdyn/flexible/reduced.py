@@ -28,7 +28,10 @@ class ReducedBody:
     * ``invariants``: the :class:`~mbdyn.flexible.invariants.Invariants`;
     * ``geometric_stiffness``: {load case: (n, n) matrix per unit load}, the beam's
       ``"centrifugal"`` (per unit ``omega_y^2 + omega_z^2``: axial force ``s_out(x)``)
-      and ``"axial_acceleration"`` (per unit ``a_x`` of the frame origin minus ``g_x``).
+      and ``"axial_acceleration"`` (per unit ``a_x`` of the frame origin minus ``g_x``);
+    * ``gyroscopic``: ``G_ee`` (n, n, skew) per unit spin about the body's x axis, of
+      ``M_ee eta'' + Omega G_ee eta' + K_ee eta = ...`` in a frame that does not spin
+      (``flexible.rotor``), or ``None``.
     """
     method: str
     mass_matrix: np.ndarray
@@ -42,6 +45,7 @@ class ReducedBody:
     reference: int | None = None
     node_names: dict = field(default_factory=dict)
     geometric_stiffness: dict = field(default_factory=dict)
+    gyroscopic: np.ndarray | None = None
 
     @property
     def n_modes(self):

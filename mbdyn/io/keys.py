@@ -31,7 +31,7 @@ JOINT_KEYS = {"name": "name", "kind": ("choice", JOINT_KINDS), "parent": "name",
 LOOP_JOINT_KEYS = ("child_position", "child_orientation", "cut", "axis2", "length",
                    "follower", "leader", "ratio", "offset")
 LOAD_KEYS = {"name": "name", "body": "name", "force": "vector", "moment": "vector",
-             "point": "vector", "frame": ("choice", ("world", "body"))}
+             "point": "place", "frame": ("choice", ("world", "body"))}
 SIMULATION_KEYS = {"t_end": "expr", "integrator": "string", "method": "string",
                    "rtol": "expr", "atol": "expr", "dt": "expr", "max_step": "expr",
                    "output_dt": "expr", "max_steps": "expr", "max_samples": "expr",
@@ -42,8 +42,8 @@ POINT_KEYS = {"frame": "name", "offset": "vector"}
 FORCE_KINDS = ("spring-damper", "joint-spring-damper", "bushing", "bearing", "contact",
                "joint-stop")
 FORCE_KEYS = {"name": "name", "kind": ("choice", FORCE_KINDS),
-              "body_a": "name", "point_a": "vector", "body_b": "name", "point_b": "vector",
-              "body": "name", "point": "vector", "housing": "name", "center": "vector",
+              "body_a": "name", "point_a": "place", "body_b": "name", "point_b": "place",
+              "body": "name", "point": "place", "housing": "name", "center": "vector",
               "joint": "name", "axis": "axis", "stiffness": "matrix6", "damping": "matrix6",
               "free_length": "expr", "preload": "expr", "rest": "expr", "min_length": "expr",
               "force_table": "table", "damping_table": "table", "law": "expr",

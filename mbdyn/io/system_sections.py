@@ -240,7 +240,7 @@ def add_loads(b):
         with b.engine(path):
             b.system.add_load(name, body, force=parts.get("force"),
                               moment=parts.get("moment"),
-                              point=b.pvector(ld.get("point"), path + ("point",)),
+                              point=_place(b, ld.get("point"), path + ("point",)),
                               frame=ld.get("frame", "world"))
         specs.append(dict(ld))
     return specs
@@ -267,12 +267,17 @@ def add_forces(b):
     return specs
 
 
+def _place(b, value, path):
+    """A point's three values, or a flexible body's node named (kept as the name)."""
+    return value if isinstance(value, str) else b.pvector(value, path)
+
+
 def _force_value(b, key, value, path):
     """The value of one key of a force element, for ``System.add_force``."""
     if key in FORCE_NAME_KEYS:
         return value
     if key in FORCE_POINT_KEYS:
-        return b.pvector(value, path)
+        return _place(b, value, path)
     if key in ("axis", "plane_normal"):
         return value if isinstance(value, str) else b.pvector(value, path)
     if key == "law":

@@ -55,6 +55,14 @@ def _vector(c, value, path):
         c.check_expr(v, path + (i,))
 
 
+def _place(c, value, path):
+    """A point: three numbers or expressions, or the name of a flexible body's node."""
+    if isinstance(value, str):
+        _name(c, value, path)
+    else:
+        _vector(c, value, path)
+
+
 def _axis(c, value, path):
     if isinstance(value, str):
         if value.strip().lower().lstrip("+-") not in ("x", "y", "z"):
@@ -234,7 +242,8 @@ def _flexible(c, value, path):
 
 #: kind -> its check
 CHECKS = {"string": _string, "name": _name, "bool": _boolean, "expr": _expression,
-          "vector": _vector, "axis": _axis, "inertia": _inertia, "orientation": _orientation,
+          "vector": _vector, "place": _place, "axis": _axis, "inertia": _inertia,
+          "orientation": _orientation,
           "names": _names, "paths": _paths, "condition": _condition, "direction": _direction,
           "reactions": _reactions, "shape": _shape, "exprs": _expressions,
           "coefficient": _coefficient, "matrix6": _matrix6, "table": _table,
