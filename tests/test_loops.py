@@ -439,7 +439,7 @@ def test_run_solve_on_the_chosen_rows_equals_the_svd_solve():
     (``kernels.constrained._chosen_rows_solve``: ``S`` of the rank's size, no pivoting);
     they equal the minimum-norm SVD solve's.  Rows that no longer span the constraints
     (a zero row chosen) fail its pivot test and the solve pivots again."""
-    from mbdyn.kernels.constrained import ROWS
+    from mbdyn.kernels.loop_solve import ROWS
     for path in ("models/andrews_squeezer.toml", "models/four_bar.toml"):
         scene = mb.load_model(path)
         m = scene.model

@@ -13,7 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError
-from ..kernels.constrained import PROJECTION_TOLERANCE, RANK_TOLERANCE
+from ..kernels.constrained import PROJECTION_TOLERANCE
+from ..kernels.loop_solve import RANK_TOLERANCE
 
 #: Newton steps at most before the assembly is declared impossible
 ASSEMBLY_ITERATIONS = 60

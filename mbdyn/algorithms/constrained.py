@@ -13,7 +13,7 @@ import numpy as np
 
 from ..errors import ModelError, SimulationError
 from ..kernels import constrained as kc
-from ..kernels.constrained import RANK_TOLERANCE
+from ..kernels.loop_solve import RANK_TOLERANCE
 
 
 def groups(model):

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..kernels import constrained as kc
 from ..kernels import constraints as kcon
+from ..kernels.loop_solve import RANK_TOLERANCE
 from ..kernels import dynamics as kd
 from .constrained import groups
 
@@ -49,7 +50,7 @@ def loop_newton_euler(model, q, u, t=0.0):
         K[:size, size + k] = -(b - b0)
     K[size:, :nu] = G
     rhs = np.concatenate([b0, gamma])
-    x = np.linalg.lstsq(K, rhs, rcond=kc.RANK_TOLERANCE)[0]
+    x = np.linalg.lstsq(K, rhs, rcond=RANK_TOLERANCE)[0]
     if not np.all(np.isfinite(x)):
         model._check_finite(q, u, t, x, "the Newton-Euler solution")
     return x[:nu].copy(), x[nu:size].copy(), x[size:].copy()

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..kernels import constraints as kcon
 from ..kernels import dynamics as kd
-from ..kernels.constrained import RANK_TOLERANCE
+from ..kernels.loop_solve import RANK_TOLERANCE
 
 #: a reaction component that moves less than this per unit self-balanced multiplier set
 #: is unique (N, or N m for moments)

@@ -23,7 +23,7 @@ import numpy as np
 from scipy.linalg import qr
 
 from ..errors import ModelError
-from ..kernels.constrained import RANK_TOLERANCE
+from ..kernels.loop_solve import RANK_TOLERANCE
 from .tangent import Tangent
 
 #: a chart's residual ``|phi|`` above this (m, or dimensionless) is a failure to close

@@ -299,7 +299,7 @@ def constraints(model, loop_joints):
     workspace: ``model._con = (con_int, con_data, phi, psi, G, gamma, lam, info)``, or
     None for a tree.  ``info``: rank, conditioning, the rank a run holds (-1: none), the
     lowest rank and conditioning a run met at its steps, then how many rows the last
-    projection chose (-1: none) and those rows (``kernels.constrained.ROWS``)."""
+    projection chose (-1: none) and those rows (``kernels.loop_solve.ROWS``)."""
     model.loop_joints = tuple(j.name for j in loop_joints)
     model._loop_joint = {j.name: j for j in loop_joints}
     if not loop_joints:

@@ -10,7 +10,7 @@ import warnings
 import numpy as np
 
 from ..errors import ModelError, SimulationError, SingularityWarning
-from ..kernels.constrained import ROWS
+from ..kernels.loop_solve import ROWS
 
 #: an initial state off its constraints by less than this is projected silently
 QUIET_PROJECTION = 1e-8

@@ -1,0 +1,345 @@
+"""Rank-tolerant solves of the constrained equations ``M u' = f + G^T lam``, ``G u' = gamma``
+(``kernels.constrained``) and of the projection's minimum-norm steps.
+
+Outside runs the rank is decided by the singular value decomposition of ``Y = L^-1 G^T``
+(``constrained_solve``) and the multipliers are the minimum-norm ones.  A run knows its
+rank (decided at every projected step) and solves on rows: the complement ``S = Y^T Y``
+factored by Cholesky with complete pivoting stopped at that rank (``_pivoted_solve``), or,
+cheaper, on the rows the last projection chose (``_chosen_rows_solve``); ``u'`` is the
+same (it is unique), the multipliers a basic solution.  A mass matrix that is only
+semi-definite takes the augmented system by least squares (``augmented_solve``).
+"""
+import numpy as np
+from numba import njit
+
+from .views import UNCOUNTED, c_view
+
+#: singular values of ``Y = L^-1 G^T`` below this fraction of the largest are taken as
+#: zero (redundant constraints, or a singular configuration)
+RANK_TOLERANCE = 1e-9
+#: during a run, a singular value of ``Y`` below this fraction of the largest is dropped
+#: although the mechanism's rank counts it: the configuration is (nearly) singular, where
+#: the stages of a step, off the manifold, would divide a residual by its square; the
+#: motion then follows its inertia along that direction for the step, and the projection
+#: puts it back on the constraints (a smooth passage, docs/constraints.md)
+PASSAGE_TOLERANCE = 1e-6
+#: ``info`` (``compiled.layout.constraints``): rank, conditioning, the rank a run holds (-1:
+#: none), the lowest rank and conditioning a run met; then, from ``ROWS``, how many rows
+#: the last pivoted factorisation of a projection chose (-1: none yet) and those rows
+ROWS = 5
+
+
+@njit(cache=True)
+def constrained_solve(M, L, ud, G, gamma, lam, info):
+    """``ud`` (holding ``M^-1 f`` on entry, ``L`` the Cholesky factor of ``M``) corrected
+    to the constrained accelerations; ``lam`` the minimum-norm multipliers.  ``info[0]``:
+    the rank of ``G``, ``info[1]``: the smallest singular value kept over the largest
+    (how far from a singular configuration)."""
+    m, nu = G.shape[0], G.shape[1]
+    if m == 0:
+        info[0], info[1] = 0.0, 1.0
+        return
+    keep = info[2]               # during a run: the rank at the last projected state
+    if keep >= 0:
+        _pivoted_solve(L, ud, G, gamma, lam, info, int(keep),
+                       np.empty(nu * m + m * m + 4 * m + nu))
+        return
+    res = gamma.copy()
+    for i in range(m):
+        for k in range(nu):
+            res[i] -= G[i, k] * ud[k]
+    Y = np.empty((nu, m))
+    for j in range(m):                              # L Y = G^T, column by column
+        for i in range(nu):
+            s = G[j, i]
+            for k in range(i):
+                s -= L[i, k] * Y[k, j]
+            Y[i, j] = s / L[i, i]
+    U, sv, Vt = np.linalg.svd(Y, full_matrices=False)
+    top = sv[0] if sv.shape[0] else 0.0
+    rank = 0
+    smallest = 1.0
+    c = np.zeros(sv.shape[0])
+    for k in range(sv.shape[0]):
+        if sv[k] > RANK_TOLERANCE * top and top > 0.0:
+            rank += 1
+            smallest = sv[k] / top
+            acc = 0.0
+            for i in range(m):
+                acc += Vt[k, i] * res[i]
+            c[k] = acc / (sv[k] * sv[k])
+    for i in range(m):
+        acc = 0.0
+        for k in range(sv.shape[0]):
+            acc += Vt[k, i] * c[k]
+        lam[i] = acc
+    _add_correction(L, ud, Y, lam, np.empty(nu), m)
+    info[0] = rank
+    info[1] = smallest
+
+
+@njit(cache=True, inline="always")
+def _add_correction(L, ud, Y, lam, z, m):
+    """``ud += M^-1 G^T lam = L^-T (Y lam)`` over the first ``m`` columns of ``Y`` (``z``:
+    nu floats of scratch)."""
+    nu = Y.shape[0]
+    for i in range(nu):
+        acc = 0.0
+        for j in range(m):
+            acc += Y[i, j] * lam[j]
+        z[i] = acc
+    for i in range(nu - 1, -1, -1):
+        s = z[i]
+        for k in range(i + 1, nu):
+            s -= L[k, i] * z[k]
+        z[i] = s / L[i, i]
+    for i in range(nu):
+        ud[i] += z[i]
+
+
+@njit(cache=True, inline="always")
+def _pivoted_cholesky(A, keep, perm):
+    """``A`` (symmetric, positive semi-definite) factored in place by Cholesky with
+    complete pivoting: at most ``keep`` pivots, none below ``PASSAGE_TOLERANCE^2`` of the
+    first (a nearly singular direction).  ``perm`` the chosen order (row numbers, as floats:
+    it lives in a float scratch); returns the number
+    of pivots, the rank used."""
+    m = A.shape[0]
+    for j in range(m):
+        perm[j] = j
+    rank = 0
+    first = 0.0
+    for k in range(min(keep, m)):
+        p = k
+        for j in range(k + 1, m):
+            if A[j, j] > A[p, p]:
+                p = j
+        if k == 0:
+            first = A[p, p]
+        if first <= 0.0 or not (A[p, p] > PASSAGE_TOLERANCE * PASSAGE_TOLERANCE * first):
+            break
+        if p != k:                                  # symmetric swap of rows and columns
+            for j in range(m):
+                A[k, j], A[p, j] = A[p, j], A[k, j]
+            for j in range(m):
+                A[j, k], A[j, p] = A[j, p], A[j, k]
+            perm[k], perm[p] = perm[p], perm[k]
+        A[k, k] = np.sqrt(A[k, k])
+        for i in range(k + 1, m):
+            A[i, k] /= A[k, k]
+        for j in range(k + 1, m):
+            for i in range(j, m):
+                A[i, j] -= A[i, k] * A[j, k]
+            for i in range(j + 1, m):
+                A[j, i] = A[i, j]
+        rank += 1
+    return rank
+
+
+@njit(cache=True, inline="always")
+def _pivoted_back(A, perm, rank, rhs, out, x):
+    """``out`` (all rows): the solution of the pivoted rows' system ``L_r L_r^T x =
+    rhs[perm[:rank]]`` at those rows, zero elsewhere (``x``: at least ``rank`` floats of
+    scratch)."""
+    for i in range(rank):
+        s = rhs[int(perm[i])]
+        for k in range(i):
+            s -= A[i, k] * x[k]
+        x[i] = s / A[i, i]
+    for i in range(rank - 1, -1, -1):
+        s = x[i]
+        for k in range(i + 1, rank):
+            s -= A[k, i] * x[k]
+        x[i] = s / A[i, i]
+    for j in range(out.shape[0]):
+        out[j] = 0.0
+    for i in range(rank):
+        out[int(perm[i])] = x[i]
+
+
+@njit(**UNCOUNTED)
+def _pivoted_solve(L, ud, G, gamma, lam, info, keep, work):
+    """The constrained ``ud`` during a run, whose rank ``keep`` is known: ``S = Y^T Y``
+    (``L Y = G^T``) factored by Cholesky with complete pivoting (``_pivoted_cholesky``),
+    and the multipliers of the rows it chose solved for, the others zero.  The rows left
+    out are combinations of the rows kept, so ``u'`` is the same as by the SVD (it is
+    unique); ``lam`` is a basic solution, not the minimum-norm one (reactions are computed
+    by ``constrained_solve`` outside runs).  An SVD costs more than a small tree's whole
+    evaluation; this, a fraction of it.  ``work``: ``nu m + m^2 + 4 m + nu`` floats; no
+    allocation, no reference counting."""
+    m, nu = G.shape[0], G.shape[1]
+    Y, A = c_view(work, 0, (nu, m)), c_view(work, nu * m, (m, m))
+    at = nu * m + m * m
+    res, perm, x, z = (c_view(work, at, (m,)), c_view(work, at + m, (m,)),
+                       c_view(work, at + 2 * m, (m,)), c_view(work, at + 3 * m, (nu,)))
+    if keep > 0 and info[ROWS] == keep and _chosen_rows_solve(L, ud, G, gamma, lam, info,
+                                                              keep, Y, A, res, x, z):
+        return
+    for j in range(m):
+        perm[j] = j
+    first = _schur_rows(L, ud, G, gamma, perm, m, Y, A, res)
+    rank = _pivoted_cholesky(A, keep, perm)
+    _pivoted_back(A, perm, rank, res, lam, x)
+    _add_correction(L, ud, Y, lam, z, m)
+    info[0] = rank
+    info[1] = A[rank - 1, rank - 1] / np.sqrt(first) if rank and first > 0 else 1.0
+
+
+@njit(cache=True, inline="always")
+def _schur_rows(L, ud, G, gamma, rows, r, Y, A, res):
+    """The residual ``res = gamma - G ud`` (every row); for the rows ``rows[:r]`` (row
+    numbers, as floats) ``Y = L^-1 G_r^T`` and ``A = Y^T Y`` (both triangles), the Schur
+    complement ``G_r M^-1 G_r^T``.  Returns ``A``'s largest diagonal entry."""
+    m, nu = G.shape[0], G.shape[1]
+    for i in range(m):
+        s = gamma[i]
+        for k in range(nu):
+            s -= G[i, k] * ud[k]
+        res[i] = s
+    for j in range(r):                              # L Y = G_r^T, column by column
+        row = int(rows[j])
+        for i in range(nu):
+            s = G[row, i]
+            for k in range(i):
+                s -= L[i, k] * Y[k, j]
+            Y[i, j] = s / L[i, i]
+    first = 0.0
+    for i in range(r):
+        for j in range(i + 1):
+            acc = 0.0
+            for k in range(nu):
+                acc += Y[k, i] * Y[k, j]
+            A[i, j] = acc
+            A[j, i] = acc
+        first = max(first, A[i, i])
+    return first
+
+
+@njit(cache=True, inline="always")
+def _chosen_rows_solve(L, ud, G, gamma, lam, info, r, Y, A, res, x, z):
+    """``_pivoted_solve`` on the ``r`` rows the last projection's factorisation chose
+    (``info[ROWS + 1:]``): the same ``u'`` (those rows span the others while the rank
+    holds), ``S`` of size ``r`` instead of ``m`` and no pivoting.  Returns False, having
+    changed nothing, when a pivot falls below ``PASSAGE_TOLERANCE^2`` of the largest
+    diagonal entry (the rows no longer independent enough: the caller pivots again)."""
+    rows = info[ROWS + 1:ROWS + 1 + r]
+    first = _schur_rows(L, ud, G, gamma, rows, r, Y, A, res)
+    for k in range(r):                              # Cholesky, lower triangle
+        d = A[k, k]
+        for j in range(k):
+            d -= A[k, j] * A[k, j]
+        if not d > PASSAGE_TOLERANCE * PASSAGE_TOLERANCE * first:
+            return False
+        A[k, k] = np.sqrt(d)
+        for i in range(k + 1, r):
+            s = A[i, k]
+            for j in range(k):
+                s -= A[i, j] * A[k, j]
+            A[i, k] = s / A[k, k]
+    _pivoted_back(A, rows, r, res, lam, x)          # the rows' multipliers, 0 elsewhere
+    _add_correction(L, ud, Y, x, z, r)
+    info[0] = r
+    info[1] = A[r - 1, r - 1] / np.sqrt(first) if first > 0 else 1.0
+    return True
+
+
+@njit(cache=True)
+def min_norm_step(G, rhs, keep, du, info):
+    """``du``: the minimum-norm solution of ``G du = rhs`` -- by ``G^T (G G^T)^+ rhs`` on
+    the rows a pivoted Cholesky of ``G G^T`` keeps (``keep`` at most) during a run, by
+    least squares (SVD) when the rank is not known (``keep < 0``).  Returns the last
+    pivot's singular value over the first's (an estimate of ``G``'s conditioning; 1.0
+    by least squares).  The rows the factorisation chose are kept in ``info[ROWS:]`` for
+    the evaluations that follow (``_chosen_rows_solve``)."""
+    m, nu = G.shape[0], G.shape[1]
+    if keep < 0:
+        x = np.linalg.lstsq(G, rhs, RANK_TOLERANCE)[0]
+        for k in range(nu):
+            du[k] = x[k]
+        return 1.0
+    return _min_norm_pivoted(G, rhs, keep, du, info, np.empty(m * m + 3 * m))
+
+
+@njit(**UNCOUNTED)
+def _min_norm_pivoted(G, rhs, keep, du, info, work):
+    """``min_norm_step`` with the rank known, in ``work`` (``m^2 + 3 m`` floats)."""
+    m, nu = G.shape[0], G.shape[1]
+    A = c_view(work, 0, (m, m))
+    perm, z, x = (c_view(work, m * m, (m,)), c_view(work, m * m + m, (m,)),
+                  c_view(work, m * m + 2 * m, (m,)))
+    for i in range(m):
+        for j in range(i + 1):
+            acc = 0.0
+            for k in range(nu):
+                acc += G[i, k] * G[j, k]
+            A[i, j] = acc
+            A[j, i] = acc
+    rank = _pivoted_cholesky(A, keep, perm)
+    info[ROWS] = rank
+    for i in range(rank):
+        info[ROWS + 1 + i] = perm[i]
+    _pivoted_back(A, perm, rank, rhs, z, x)
+    for k in range(nu):
+        acc = 0.0
+        for i in range(m):
+            acc += G[i, k] * z[i]
+        du[k] = acc
+    return A[rank - 1, rank - 1] / A[0, 0] if rank else 1.0
+
+
+@njit(cache=True)
+def augmented_solve(M, f, G, gamma, ud, lam, info):
+    """The same equations as one least-squares system ``[[M, G^T], [G, 0]] [u', -lam] =
+    [f, gamma]`` (minimum norm): for a mass matrix that is only semi-definite.  Returns
+    False when ``u'`` is not determined (the constrained mass matrix is singular)."""
+    m, nu = G.shape[0], G.shape[1]
+    K = np.zeros((nu + m, nu + m))
+    rhs = np.zeros(nu + m)
+    for i in range(nu):
+        for k in range(nu):
+            K[i, k] = M[i, k]
+        rhs[i] = 0.0
+    for j in range(m):
+        for i in range(nu):
+            K[nu + j, i] = G[j, i]
+            K[i, nu + j] = G[j, i]
+        rhs[nu + j] = gamma[j]
+    x, _, rank, sv = np.linalg.lstsq(K, np.concatenate((ud, rhs[nu:])), RANK_TOLERANCE)
+    # rank of [M; G] decides whether u' is unique: u' has nu unknowns
+    MG = np.zeros((nu + m, nu))
+    for i in range(nu):
+        for k in range(nu):
+            MG[i, k] = M[i, k]
+    for j in range(m):
+        for k in range(nu):
+            MG[nu + j, k] = G[j, k]
+    svm = np.linalg.svd(MG)[1]
+    ok = True
+    if nu and svm.shape[0] and svm[nu - 1] <= RANK_TOLERANCE * svm[0]:
+        ok = False
+    for i in range(nu):
+        ud[i] = x[i]
+    for j in range(m):
+        lam[j] = -x[nu + j]
+    info[0] = np.linalg.matrix_rank(G, RANK_TOLERANCE * max(1.0, np.abs(G).max())) if m else 0
+    info[1] = 1.0
+    return ok
+
+
+
+@njit(cache=True)
+def rank_of(G):
+    """``(rank, conditioning)``: the singular values of ``G`` above ``RANK_TOLERANCE`` of
+    the largest, and the smallest of them over the largest."""
+    if G.shape[0] == 0 or G.shape[1] == 0:
+        return 0, 1.0
+    sv = np.linalg.svd(G)[1]
+    if sv[0] <= 0.0:
+        return 0, 1.0
+    rank = 0
+    for k in range(sv.shape[0]):
+        if sv[k] > RANK_TOLERANCE * sv[0]:
+            rank += 1
+    return rank, sv[rank - 1] / sv[0]
+
+
