@@ -373,3 +373,18 @@ def test_a_guess_where_newton_cannot_start_settles_by_dynamic_relaxation():
     # hanging: both links along -z, i.e. shoulder = +pi/2 about y, elbow = 0
     assert abs(math.remainder(eq.q[0] - math.pi / 2, 2 * math.pi)) < 1e-9
     assert abs(eq.q[1]) < 1e-9 and eq.residual < 1e-9
+
+
+def test_campbell_crossings_of_heavily_damped_modes_are_no_critical_speeds():
+    """A spin line crossed by a lightly damped mode is a critical speed; by a mode damped
+    above ``CRITICALLY_DAMPED`` (amplification factor below 2.5, API 684), a crossing
+    listed apart with its damping ratio, interpolated at the crossing."""
+    from mbdyn.analysis.campbell import CRITICALLY_DAMPED, _crossings_of
+    values = np.array([0.0, 100.0, 200.0])
+    freq = np.array([[150.0, 150.0], [150.0, 100.0], [150.0, 50.0]])
+    real = -np.ones((3, 2))
+    zeta = np.array([[0.05, 0.1], [0.05, 0.5], [0.05, 0.9]])
+    critical, onset, damped = _crossings_of(values, freq, real, zeta, [1], True)
+    assert critical == [(0, 1, 150.0)] and onset == []
+    assert damped[0][:3] == (1, 1, 100.0) and damped[0][3] == pytest.approx(0.5)
+    assert 0.05 < CRITICALLY_DAMPED < 0.5

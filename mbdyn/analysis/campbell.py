@@ -30,6 +30,10 @@ def mac(a, b):
     return float(num / den) if den > 0 else 0.0
 
 
+#: a crossing of a spin line by a mode damped above this ratio is no critical speed: its
+#: amplification factor ``1 / (2 zeta)`` is below 2.5, API 684's "critically damped"
+#: (such crossings are listed apart, ``Campbell.damped``)
+CRITICALLY_DAMPED = 0.2
 #: the damping ratios the Campbell diagram's colour scale spans (beyond: its end colours);
 #: its neutral colour is at zeta = 0
 ZETA_RANGE = (-0.2, 0.5)
@@ -40,7 +44,8 @@ class Campbell:
     """``values`` of ``parameter``; per tracked mode (columns) the damped frequency
     ``frequency`` (rad/s), ``real_part``, ``damping_ratio`` and ``whirl``; ``mac`` the
     shape correlation of each step; ``critical`` ``[(mode, order, value)]``; ``onset``
-    ``[(mode, value)]``."""
+    ``[(mode, value)]``; ``damped`` ``[(mode, order, value, zeta)]``: crossings of modes
+    damped above ``CRITICALLY_DAMPED``, which are not critical speeds."""
     parameter: str
     values: np.ndarray
     frequency: np.ndarray
@@ -51,6 +56,7 @@ class Campbell:
     critical: list = field(default_factory=list)
     onset: list = field(default_factory=list)
     spin_is_parameter: bool = True
+    damped: list = field(default_factory=list)
 
     def to_dict(self):
         return {"parameter": self.parameter, "values": self.values.tolist(),
@@ -62,7 +68,10 @@ class Campbell:
                 "tracking_mac_min": float(self.mac.min()) if self.mac.size else 1.0,
                 "critical_speeds": [{"mode": m + 1, "order": o, "value": v}
                                     for m, o, v in self.critical],
-                "instability_onset": [{"mode": m + 1, "value": v} for m, v in self.onset]}
+                "instability_onset": [{"mode": m + 1, "value": v} for m, v in self.onset],
+                "critically_damped_crossings": [{"mode": m + 1, "order": o, "value": v,
+                                                 "damping_ratio": z}
+                                                for m, o, v, z in self.damped]}
 
     def table(self):
         n = self.frequency.shape[1]
@@ -80,6 +89,10 @@ class Campbell:
         for m, o, v in self.critical:
             lines.append(f"critical speed: mode {m + 1} meets the {o}x line at "
                          f"{self.parameter} = {v:.6g}")
+        for m, o, v, z in self.damped:
+            lines.append(f"mode {m + 1} meets the {o}x line at {self.parameter} = {v:.6g} "
+                         f"critically damped (zeta {z:.3g} > {CRITICALLY_DAMPED}): no "
+                         "critical speed")
         for m, v in self.onset:
             lines.append(f"onset of instability: mode {m + 1} at {self.parameter} = {v:.6g}")
         if not self.onset:
@@ -213,9 +226,10 @@ def campbell(scene, parameter, values, orders=(1,), whirl=(), at="equilibrium",
                           progress)
     order, macs = _track(rows)
     freq, real, zeta, whirls = _tracked(rows, order)
-    critical, onset = _crossings_of(values, freq, real, orders, spin_is_parameter)
+    critical, onset, damped = _crossings_of(values, freq, real, zeta, orders,
+                                            spin_is_parameter)
     return Campbell(parameter, values, freq, real, zeta, whirls, np.array(macs),
-                    critical, onset, spin_is_parameter)
+                    critical, onset, spin_is_parameter, damped)
 
 
 def _checked(parameter, orders, whirl, at, fixed, progress):
@@ -308,22 +322,31 @@ def _tracked(rows, order):
     return freq, real, zeta, whirls
 
 
-def _crossings_of(values, freq, real, orders, spin_is_parameter):
+def _crossings_of(values, freq, real, zeta, orders, spin_is_parameter):
     """``critical``: ``(mode, order, value)`` where a mode's frequency meets a spin line
-    (where it oscillates on both sides); ``onset``: ``(mode, value)`` where its real part
-    crosses zero; both sorted by value."""
-    critical, onset = [], []
+    (where it oscillates on both sides) damped at most ``CRITICALLY_DAMPED`` there (the
+    ratio interpolated linearly); ``onset``: ``(mode, value)`` where its real part crosses
+    zero; ``damped``: ``(mode, order, value, zeta)``, the crossings of modes damped more;
+    each sorted by value."""
+    critical, onset, damped = [], [], []
     for k in range(freq.shape[1]):
         if spin_is_parameter:
             oscillating = freq[:, k] > 0
             for o in orders:
                 gap = freq[:, k] - o * np.abs(values)
                 for i in range(len(values) - 1):     # only where the mode oscillates
-                    if oscillating[i] and oscillating[i + 1]:
-                        critical.extend((k, o, v) for v in _crossings(values[i:i + 2],
-                                                                        gap[i:i + 2]))
+                    if not (oscillating[i] and oscillating[i + 1]):
+                        continue
+                    for v in _crossings(values[i:i + 2], gap[i:i + 2]):
+                        x0, x1, z0, z1 = values[i], values[i + 1], zeta[i, k], zeta[i + 1, k]
+                        z = float(z0 + (z1 - z0) * (v - x0) / (x1 - x0) if x1 != x0 else z0)
+                        if z > CRITICALLY_DAMPED:
+                            damped.append((k, o, v, z))
+                        else:
+                            critical.append((k, o, v))
         for v in _onsets(values, real[:, k], freq[:, k]):
             onset.append((k, v))
     critical.sort(key=lambda c: c[2])
     onset.sort(key=lambda c: c[1])
-    return critical, onset
+    damped.sort(key=lambda c: c[2])
+    return critical, onset, damped
