@@ -31,7 +31,7 @@ from numba import njit
 from .events import step_ends_stretch
 from .integrators import _rhs, finish_step
 from .programs import STACK, drive_values
-from .views import untracked
+from .views import UNCOUNTED, untracked
 
 RK45, DOP853 = 0, 1
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
@@ -178,7 +178,7 @@ TABLEAUS = {
 }
 
 
-@njit(cache=True, inline="always")
+@njit(**UNCOUNTED)
 def _stage(t, y, ops, consts, starts, stack, dv, nq, slots, free_q, free_u, drive_q, drive_u,
            tree, body, loads, ws, ydot, nfev):
     """The right-hand side at time ``t`` (drives evaluated there) and state ``y``."""
@@ -186,6 +186,15 @@ def _stage(t, y, ops, consts, starts, stack, dv, nq, slots, free_q, free_u, driv
         drive_values(ops, consts, starts, t, stack, dv)
     return _rhs(y, dv, nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads, ws,
                 ydot, nfev)
+
+
+@njit(cache=True, inline="always")
+def _failed(t, y, fail):
+    """``fail = [t, y]``: a failing stage's time and state (element by element: an array
+    assignment makes numba compile its shape-mismatch message, seconds of a first run)."""
+    fail[0] = t
+    for i in range(y.shape[0]):
+        fail[1 + i] = y[i]
 
 
 @njit(cache=True, inline="always")
@@ -212,8 +221,7 @@ def _dense_coefficients(A, C, D, stages, t_old, y_old, y_new, h, K, F, tmp, ops,
         st = _stage(t_old + C[s] * h, tmp, ops, consts, starts, stack, dv, nq, slots, free_q,
                     free_u, drive_q, drive_u, tree, body, loads, ws, K[s], nfev)
         if st:
-            fail[0] = t_old + C[s] * h
-            fail[1:] = tmp
+            _failed(t_old + C[s] * h, tmp, fail)
             return st
     n = y_old.shape[0]
     f_new = K[stages - 1]
@@ -308,8 +316,7 @@ def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_s
                             free_q, free_u, drive_q, drive_u, tree, body, loads, ws, K[s],
                             nfev)
                 if st:
-                    fail[0] = t + C[s] * h
-                    fail[1:] = tmp
+                    _failed(t + C[s] * h, tmp, fail)
                     return accepted, st, h_abs, i_eval
             for i in range(n):
                 acc = 0.0
@@ -319,8 +326,7 @@ def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_s
             st = _stage(t_new, y_new, ops, consts, starts, stack, dv, nq, slots, free_q,
                         free_u, drive_q, drive_u, tree, body, loads, ws, K[stages - 1], nfev)
             if st:
-                fail[0] = t_new
-                fail[1:] = y_new
+                _failed(t_new, y_new, fail)
                 return accepted, st, h_abs, i_eval
             # error norm
             if kind == RK45:
@@ -383,8 +389,7 @@ def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_s
                             free_u, drive_q, drive_u, tree, body, loads, ws, K[stages - 1],
                             nfev)
             if st:
-                fail[0] = t_new
-                fail[1:] = y_new
+                _failed(t_new, y_new, fail)
                 return accepted, st, h_abs, i_eval
         if keep_stages:
             row = min(accepted, keep_stages - 1)
@@ -396,7 +401,8 @@ def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_s
             f[i] = K[stages - 1, i]
         t = t_new
         out_t[accepted] = t
-        out_y[accepted] = y
+        for i in range(n):
+            out_y[accepted, i] = y[i]
         out_h[accepted] = h
         out_nfev[accepted] = nfev[0]
         out_ieval[accepted] = i_eval
@@ -413,7 +419,9 @@ def dense_step(A, C, D, stages, t_old, y_old, y_new, h, K_step, ops, consts, sta
     (``out_K[k]`` of ``rk_stretch``); returns ``(F, status)``."""
     n = y_old.shape[0]
     K = np.zeros((A.shape[0], n))
-    K[:stages] = K_step[:stages]
+    for s in range(stages):
+        for i in range(n):
+            K[s, i] = K_step[s, i]
     F = np.empty((3 + D.shape[0], n))
     tmp = np.empty(n)
     fail = np.empty(n + 1)
