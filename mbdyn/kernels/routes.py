@@ -27,7 +27,7 @@ def accelerations(tree, body, loads, ws, ud):
     raise NotImplementedError("compiled code only")
 
 
-@overload(accelerations, inline="always")
+@overload(accelerations, jit_options={"_nrt": False})
 def _accelerations_route(tree, body, loads, ws, ud):
     """The formulation is chosen when the loop is compiled, by the workspace's type: 18
     arrays (``M``, ``f``, ``L``, scratch last) for ``M u' = f``, 26 (the same and the
@@ -69,7 +69,7 @@ def finish_step(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_
     raise NotImplementedError("compiled code only")
 
 
-@overload(finish_step, inline="always")
+@overload(finish_step, jit_options={"_nrt": False})
 def _finish_step_route(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_u,
                        tree, ws):
     """Chosen by the workspace's layout, as ``accelerations``: a tree only normalises."""
