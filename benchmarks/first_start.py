@@ -51,13 +51,17 @@ CHILD_ENV = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECOD
 
 
 #: ``(name, command line)`` of each feature's first use, on the shipped models (run in a copy
-#: of the checkout's ``models/``); ``{tmp}`` is a scratch folder
+#: of the checkout's ``models/``) and ``mbdyn warmup``'s six-link chain (no shipped model is
+#: a tree of 6 or more speeds without force elements); ``{tmp}`` is a scratch folder that
+#: holds ``chain.toml``
 FEATURES = (
     ("README command (`run models/top.toml --case a`)", COMMAND[2:]),
     ("adaptive run (DOP853), small tree", ["run", "models/double_pendulum.toml",
                                            "--integrator", "DOP853"]),
     ("force elements (DOP853)", ["run", "models/mass_spring_damper.toml"]),
-    ("articulated route (6 speeds, DOP853)", ["run", "models/arm6.urdf", "--t-end", "1"]),
+    ("articulated route (6+ speeds, DOP853)", ["run", "{tmp}/chain.toml"]),
+    ("URDF arm (6 speeds, joint stops, DOP853)", ["run", "models/arm6.urdf", "--t-end",
+                                                  "1"]),
     ("closed loop (four-bar, DOP853)", ["run", "models/four_bar.toml"]),
     ("batched sweep (rk4)", ["sweep", "models/double_pendulum.toml", "--grid",
                              "initial.theta1=0.1:0.5:4", "--integrator", "rk4", "--batched",
@@ -124,6 +128,17 @@ def cache_files(root, suffix=".nbi"):
             if f.endswith(suffix)]
 
 
+def write_chain(tmp, folder):
+    """``folder/chain.toml``: the six-link chain of ``mbdyn warmup`` (its model files are
+    Python strings: read from the copy in ``tmp`` without importing the package)."""
+    path = os.path.join(tmp, "mbdyn", "cli", "warmup_models.py")
+    namespace = {}
+    with open(path, encoding="utf-8") as f:
+        exec(compile(f.read(), path, "exec"), namespace)
+    with open(os.path.join(folder, "chain.toml"), "w", encoding="utf-8") as f:
+        f.write(namespace["MODELS"]["chain"])
+
+
 def measure_features(source, names=None, n_warm=1):
     """``{feature: (kernels, cold wall, cold cpu, warm wall, warm cpu)}``: each feature
     cold in a fresh process with an empty numba cache of its own, then ``n_warm`` times
@@ -141,6 +156,7 @@ def measure_features(source, names=None, n_warm=1):
                 continue
             cache = tempfile.mkdtemp(prefix="cache-", dir=tmp)
             scratch = tempfile.mkdtemp(prefix="scratch-", dir=tmp)
+            write_chain(tmp, scratch)
             args = ["-m", "mbdyn", *[w.format(tmp=scratch) for w in line]]
             env = {"NUMBA_CACHE_DIR": cache}
             cold = timed(args, tmp, env)
