@@ -255,7 +255,7 @@ class Model:
         return out
 
     def loop_arguments(self, method="jourdain"):
-        """The arrays ``kernels.integrators.fixed_step_loop`` needs after its drive table:
+        """The arrays the compiled loops (``kernels.integrators.LOOPS``) take after the drive table:
         ``(nq, slots, quats, free_q, free_u, drive_q, drive_u, tree, body, loads, ws)``;
         laid out for ``method`` ``"jourdain"`` or ``"articulated"`` (the compiled loops
         choose their route by the workspace's layout, ``integrators.accelerations``)."""
