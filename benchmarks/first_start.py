@@ -1,6 +1,8 @@
-"""First start: the cost of ``import mbdyn`` and of a cold and a warm ``mbdyn run``.
+"""First start: the cost of ``import mbdyn``, of a cold and a warm ``mbdyn run``, and of
+each feature's first use.
 
     python benchmarks/first_start.py [--warm 3] [--cold 1] [--source DIR]
+    python benchmarks/first_start.py --features [NAME ...] [--source DIR]
 
 Copies the package (``mbdyn/`` of ``--source``, default this checkout) and the model into a
 temporary directory, so that the cold runs start from an empty numba cache without
@@ -17,7 +19,16 @@ wrote.  Where that variable is set, every run compiles the package's Python sour
 about 0.1 s that a user does not pay.
 
 Prints a markdown table of the medians (wall time and CPU time: user + system of the
-child) over the runs.  The machine's load shows in the wall times; compare CPU times, and
+child) over the runs.
+
+``--features`` instead times the cold first use of each feature (``FEATURES``: the
+README's command, an adaptive run, force elements, the articulated route, a closed loop,
+a batched sweep, modes, an HTML animation), each in a fresh process with an empty numba
+cache of its own (``NUMBA_CACHE_DIR`` set to a new folder: numba's cache locator takes it
+before the package's ``__pycache__``, and the benchmark checks that the copy's folders
+received no cache file), then the same command again warm, from that cache.  Cold minus
+warm is about what compiling costs; "kernels" counts the compiled entry points numba
+wrote to the cache (its index files).  The machine's load shows in the wall times; compare CPU times, and
 compare against a baseline measured in the same session (``--source`` of another
 checkout, e.g. a ``git worktree`` of an older commit).
 """
@@ -39,12 +50,34 @@ COMMAND = ["-m", "mbdyn", "run", "models/top.toml", "--case", "a"]
 CHILD_ENV = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
 
 
-def timed(args, cwd):
+#: ``(name, command line)`` of each feature's first use, on the shipped models (run in a copy
+#: of the checkout's ``models/``) and ``mbdyn warmup``'s six-link chain (no shipped model is
+#: a tree of 6 or more speeds without force elements); ``{tmp}`` is a scratch folder that
+#: holds ``chain.toml``
+FEATURES = (
+    ("README command (`run models/top.toml --case a`)", COMMAND[2:]),
+    ("adaptive run (DOP853), small tree", ["run", "models/double_pendulum.toml",
+                                           "--integrator", "DOP853"]),
+    ("force elements (DOP853)", ["run", "models/mass_spring_damper.toml"]),
+    ("articulated route (6+ speeds, DOP853)", ["run", "{tmp}/chain.toml"]),
+    ("URDF arm (6 speeds, joint stops, DOP853)", ["run", "models/arm6.urdf", "--t-end",
+                                                  "1"]),
+    ("closed loop (four-bar, DOP853)", ["run", "models/four_bar.toml"]),
+    ("batched sweep (rk4)", ["sweep", "models/double_pendulum.toml", "--grid",
+                             "initial.theta1=0.1:0.5:4", "--integrator", "rk4", "--batched",
+                             "--json"]),
+    ("modes", ["modes", "models/double_pendulum.toml"]),
+    ("animate (HTML)", ["animate", "models/double_pendulum.toml", "--out",
+                        "{tmp}/pendulum.html"]),
+)
+
+
+def timed(args, cwd, env=None):
     """Run ``python ARGS`` in ``cwd``; returns ``(wall s, cpu s)`` of the child."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     subprocess.run([sys.executable, *args], cwd=cwd, check=True, stdout=subprocess.DEVNULL,
-                   stderr=subprocess.DEVNULL, env=CHILD_ENV | {"PYTHONPATH": cwd})
+                   stderr=subprocess.DEVNULL, env=CHILD_ENV | {"PYTHONPATH": cwd} | (env or {}))
     wall = time.perf_counter() - start
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
@@ -89,6 +122,54 @@ def measure(source, n_warm, n_cold, n_import):
         return out
 
 
+def cache_files(root, suffix=".nbi"):
+    """Paths of numba's cache index files under ``root``."""
+    return [os.path.join(d, f) for d, _, files in os.walk(root) for f in files
+            if f.endswith(suffix)]
+
+
+def write_chain(tmp, folder):
+    """``folder/chain.toml``: the six-link chain of ``mbdyn warmup`` (its model files are
+    Python strings: read from the copy in ``tmp`` without importing the package)."""
+    path = os.path.join(tmp, "mbdyn", "cli", "warmup_models.py")
+    namespace = {}
+    with open(path, encoding="utf-8") as f:
+        exec(compile(f.read(), path, "exec"), namespace)
+    with open(os.path.join(folder, "chain.toml"), "w", encoding="utf-8") as f:
+        f.write(namespace["MODELS"]["chain"])
+
+
+def measure_features(source, names=None, n_warm=1):
+    """``{feature: (kernels, cold wall, cold cpu, warm wall, warm cpu)}``: each feature
+    cold in a fresh process with an empty numba cache of its own, then ``n_warm`` times
+    warm from that cache (medians)."""
+    out = {}
+    with tempfile.TemporaryDirectory(prefix="mbdyn-first-use-") as tmp:
+        shutil.copytree(os.path.join(source, "mbdyn"), os.path.join(tmp, "mbdyn"),
+                        ignore=shutil.ignore_patterns("__pycache__"))
+        shutil.copytree(os.path.join(source, "models"), os.path.join(tmp, "models"))
+        # Python's own bytecode first, so that no feature pays for it
+        subprocess.run([sys.executable, "-m", "compileall", "-q", "mbdyn"], cwd=tmp,
+                       check=True, env=CHILD_ENV)
+        for name, line in FEATURES:
+            if names and not any(n.lower() in name.lower() for n in names):
+                continue
+            cache = tempfile.mkdtemp(prefix="cache-", dir=tmp)
+            scratch = tempfile.mkdtemp(prefix="scratch-", dir=tmp)
+            write_chain(tmp, scratch)
+            args = ["-m", "mbdyn", *[w.format(tmp=scratch) for w in line]]
+            env = {"NUMBA_CACHE_DIR": cache}
+            cold = timed(args, tmp, env)
+            warm = [timed(args, tmp, env) for _ in range(n_warm)]
+            stray = cache_files(os.path.join(tmp, "mbdyn"))
+            if stray:
+                raise RuntimeError(f"numba wrote cache files beside the source, not in "
+                                   f"NUMBA_CACHE_DIR: {stray[:3]}")
+            out[name] = (len(cache_files(cache)), *cold, *median(warm))
+            print(f"  {name}: cold {cold[1]:.1f} s CPU", file=sys.stderr, flush=True)
+    return out
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--warm", type=int, default=3, help="warm runs (default 3)")
@@ -98,7 +179,20 @@ def main(argv=None):
     parser.add_argument("--source", default=HERE,
                         help="checkout whose mbdyn/ and models/top.toml to measure "
                              "(default this one)")
+    parser.add_argument("--features", nargs="*", metavar="NAME",
+                        help="time each feature's cold first use instead (FEATURES; names "
+                             "by any part, default all)")
     args = parser.parse_args(argv)
+    if args.features is not None:
+        rows = measure_features(os.path.abspath(args.source), args.features,
+                                max(args.warm, 1))
+        print(f"{os.cpu_count()} cores, Python {sys.version.split()[0]}, "
+              f"source {os.path.abspath(args.source)}\n")
+        print("| feature (first use) | kernels | cold wall (s) | cold CPU (s) | warm CPU (s) |")
+        print("|---|---:|---:|---:|---:|")
+        for name, (k, cw, cc, ww, wc) in rows.items():
+            print(f"| {name} | {k} | {cw:.1f} | {cc:.1f} | {wc:.1f} |")
+        return
     rows = measure(os.path.abspath(args.source), args.warm, args.cold, args.imports)
     print(f"{os.cpu_count()} cores, Python {sys.version.split()[0]}, "
           f"source {os.path.abspath(args.source)}\n")

@@ -9,8 +9,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError
-from ..kernels import entries
 from ..kernels import packed as kp
+from .inputs import plain as _plain
 from .loop_newton_euler import loop_newton_euler
 
 
@@ -20,9 +20,6 @@ from .loop_newton_euler import loop_newton_euler
 #: textbook writes it, assembled dense and solved by LU
 METHODS = ("jourdain", "articulated", "newton-euler", "newton-euler-dense")
 
-
-#: the compiled entry of each per-call route
-FORWARD = {"jourdain": entries.jourdain_forward, "articulated": entries.articulated_forward}
 
 #: "auto" takes the articulated-body route from this many free speeds on (below it the
 #: mass matrix and its Cholesky factor are as cheap or cheaper: at 4 speeds the two cost
@@ -51,33 +48,35 @@ def forward_dynamics(model, q, u, t=0.0, method="auto"):
 
 
 def _accelerations(model, q, u, t, method):
-    """``u'`` by one compiled entry (``kernels.entries``) into a new array: float64 arrays
-    as they come, anything else converted and checked first."""
-    if method == "jourdain" and model._jourdain_kernel is None:
-        model._full_workspace()                  # its arrays not yet allocated
-    call = entries.entry(FORWARD[method], entries.FORWARD_SIGNATURE)
-    out = np.empty(model.nu)
-    fb, ib, _ = model._packed
-    status = entries.WRONG_SIZE
-    if not model._python_inputs:
+    """``u'`` by one packed kernel into a new array: float64 arrays as they come, anything
+    else converted and checked first."""
+    if method == "jourdain":
+        kernel = model._jourdain_kernel
+        if kernel is None:                       # its arrays not yet allocated
+            model._full_workspace()
+            kernel = model._jourdain_kernel
+    else:
+        kernel = kp.articulated_accelerations_packed
+    status = None
+    if not model._python_inputs and _plain(q, model.nq) and _plain(u, model.nu):
         try:
-            status = call(fb, ib, q, u, out)
-        except (TypeError, ZeroDivisionError):
+            status = kernel(*model._packed, q, u)
+        except ZeroDivisionError:
             pass
-    if status == entries.WRONG_SIZE:             # convert, check, say what is wrong
+    if status is None:                           # convert, check, say what is wrong
         q, u = model._state(q, u)
-        q, u = np.require(q, float, "CW"), np.require(u, float, "CW")  # the entry's types
+        q, u = np.require(q, float, "CW"), np.require(u, float, "CW")  # one compiled type
         if model._python_inputs:
             model._fill_inputs(q, u, t)
         try:
-            status = call(fb, ib, q, u, out)
+            status = kernel(*model._packed, q, u)
         except ZeroDivisionError:
             raise model._division_by_zero(q, t) from None
     if status >= 0:
         model._raise_singular(q, t, status)
     if status == -2:
-        model._check_finite(q, u, t, out, "the accelerations")
-    return out
+        model._check_finite(q, u, t, model._ud, "the accelerations")
+    return model._ud.copy()
 
 
 def formulation(model, method="auto"):

@@ -49,6 +49,13 @@ def require_finite(model, q, u, t=0.0):
                              "speeds")
 
 
+def plain(x, n):
+    """Whether ``x`` is what the packed kernels take as it is: a float64 numpy array of
+    ``n`` entries, C-contiguous and writable (anything else is converted first)."""
+    return (type(x) is np.ndarray and x.dtype == np.float64 and x.shape == (n,)
+            and x.flags.c_contiguous and x.flags.writeable)
+
+
 def state(model, q, u):
     q, u = model._as_arrays(q, u)
     if q.shape != (model.nq,) or u.shape != (model.nu,):

@@ -10,7 +10,8 @@ import numpy as np
 
 from ..errors import NonFiniteError
 from ..kernels import dynamics as kd
-from ..kernels import entries
+from ..kernels import inverse as ki
+from .inputs import plain as _plain
 from ..kernels import packed as kp
 
 
@@ -30,21 +31,19 @@ def mass_matrix(model, q, t=0.0):
     in one compiled call (``kernels.inverse``: each joint's motion subspace, no full
     Jacobians, O(n depth))."""
     M = np.empty((model.nu, model.nu))
-    fb, ib, _ = model._packed
-    call = entries.entry(entries.mass_matrix, entries.MASS_MATRIX_SIGNATURE)
-    status = entries.WRONG_SIZE
-    if not model._python_inputs:
+    status = None
+    if not model._python_inputs and _plain(q, model.nq):
         try:                                 # a float64 array as it comes: no conversion
-            status = call(fb, ib, q, M)
-        except (TypeError, ZeroDivisionError):
+            status = ki.mass_matrix_packed(*model._packed, q, M)
+        except ZeroDivisionError:
             pass
     u = np.zeros(model.nu)
-    if status == entries.WRONG_SIZE:         # convert, check, say what is wrong
+    if status is None:                       # convert, check, say what is wrong
         q = np.require(model._state(q, u)[0], float, "CW")  # the entry's type
         if model._python_inputs:             # the drives' coordinates at t
             model._fill_inputs(q, u, t)
         try:
-            status = call(fb, ib, q, M)
+            status = ki.mass_matrix_packed(*model._packed, q, M)
         except ZeroDivisionError:
             raise model._division_by_zero(q, t) from None
     if status == -2:

@@ -9,7 +9,8 @@ import numpy as np
 
 from ..errors import ModelError
 from ..kernels import dynamics as kd
-from ..kernels import entries
+from ..kernels import inverse as ki
+from .inputs import plain as _plain
 from .forward_dynamics import ARTICULATED_FROM, METHODS
 from .loop_newton_euler import loop_newton_euler_reactions
 from .newton_euler import tree_order
@@ -100,15 +101,14 @@ def effort_array(model, q, u, u_dot, t=0.0):
     efforts without its dictionaries, by the recursive Newton-Euler algorithm in one
     compiled call (O(n); a closed mechanism by ``M u' - f`` of its tree)."""
     tau = np.empty(model.nu)
-    fb, ib, _ = model._packed
-    call = entries.entry(entries.inverse_dynamics, entries.INVERSE_SIGNATURE)
-    status = entries.WRONG_SIZE
-    if model._con is None and not model._python_inputs:
+    status = None
+    if (model._con is None and not model._python_inputs and _plain(q, model.nq)
+            and _plain(u, model.nu) and _plain(u_dot, model.nu)):
         try:                             # float64 arrays as they come: no conversion
-            status = call(fb, ib, q, u, u_dot, tau)
-        except (TypeError, ZeroDivisionError):
+            status = ki.inverse_dynamics_packed(*model._packed, q, u, u_dot, tau)
+        except ZeroDivisionError:
             pass
-    if status == entries.WRONG_SIZE:     # convert, check, say what is wrong
+    if status is None:                   # convert, check, say what is wrong
         q, u = model._state(q, u)
         ud = _rates(model, u_dot)
         if model._con is not None:
@@ -117,7 +117,7 @@ def effort_array(model, q, u, u_dot, t=0.0):
         if model._python_inputs:
             model._fill_inputs(q, u, t)
         try:
-            status = call(fb, ib, q, u, ud, tau)
+            status = ki.inverse_dynamics_packed(*model._packed, q, u, ud, tau)
         except ZeroDivisionError:
             raise model._division_by_zero(q, t) from None
     if status == -2:

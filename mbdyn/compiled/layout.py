@@ -256,7 +256,10 @@ def pack(model):
         {k: getattr(model, attr[k]) for k in kp.FAR})
     for name, view in views.items():
         setattr(model, attr[name], view)
-    model._packed = (fbuf, ibuf, table)
+    # the force table, or None without force elements: the kernels are then compiled
+    # without the force kernel (kernels.packed)
+    forces = model._force_int if model._force_int.shape[0] else None
+    model._packed = (fbuf, ibuf, table, forces)
 
 
 def full_workspace(model):
@@ -287,8 +290,7 @@ def argument_groups(model):
     model._tree = (model._parent, model._kind, model._axis, model._seq, model._pos, model._C,
                    model._qoff, model._uoff, model._ucol, model._anc_ptr, model._anc_idx)
     model._loads_arrays = (model._load_body, model._load_point, model._load_force,
-                           model._load_moment, model._load_in_body,
-                           model._force_int if model._force_int.shape[0] else None,
+                           model._load_moment, model._load_in_body, model._packed[3],
                            model._force_data, model._switches)
     model._kin_out = (model._R, model._r, model._w, model._v, model._alpha, model._a,
                       model._JR, model._JT, model._S, model._F, model._N)

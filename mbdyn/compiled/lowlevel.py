@@ -36,7 +36,7 @@ def _state(derivative, fb, ib, y, ydot):
     """``derivative`` (a packed kernel) of ``y`` into ``ydot``, after the sizes."""
     if y.shape[0] != ib[7] + ib[1] or ydot.shape[0] != y.shape[0]:
         return WRONG_SIZE
-    return derivative(fb, ib, ib, y, ydot)
+    return derivative(fb, ib, ib, kp.force_table(ib, ib), y, ydot)
 
 
 def _jourdain_state(fb, ib, y, ydot):
@@ -53,7 +53,7 @@ def _tree_reactions(fb, ib, q, u, out):
     n = ib[0]
     if q.shape[0] != ib[7] or u.shape[0] != ib[1] or out.shape[0] != n or out.shape[1] != 6:
         return WRONG_SIZE
-    status = kp.newton_euler_tree_packed(fb, ib, ib, q, u)
+    status = kp.newton_euler_tree_packed(fb, ib, ib, kp.force_table(ib, ib), q, u)
     wrench = c_view(fb, ib[kp.WRENCH], (n, 6))
     for i in range(n):
         for k in range(6):
@@ -84,7 +84,7 @@ class LowLevel:
         if method == "jourdain":
             model._full_workspace()
         self._fd, self._sd = (_entry(f, sig) for f, sig in zip(ROUTES[method], SIGNATURES))
-        self._fb, self._ib, _ = model._packed
+        self._fb, self._ib = model._packed[:2]
         self._ud = model._ud
         self._inputs = model._python_inputs
         self._nq, self._nu = model.nq, model.nu

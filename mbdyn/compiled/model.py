@@ -256,10 +256,11 @@ class Model:
         return out
 
     def loop_arguments(self, method="jourdain"):
-        """The arrays ``kernels.integrators.fixed_step_loop`` needs after its drive table:
-        ``(nq, slots, quats, free_q, free_u, drive_q, drive_u, tree, body, loads, ws)``;
-        laid out for ``method`` ``"jourdain"`` or ``"articulated"`` (the compiled loops
-        choose their route by the workspace's layout, ``integrators.accelerations``)."""
+        """The arrays the compiled loops (``kernels.integrators.LOOPS``) take after their
+        drive table: ``(nq, slots, quats, free_q, free_u, drive_q, drive_u, tree, body,
+        loads, ws)``; laid out for ``method`` ``"jourdain"`` or ``"articulated"`` (the
+        compiled loops choose their route by the workspace's layout,
+        ``routes.accelerations``)."""
         slots = self._slots
         quats = np.array([s.start for s in self._quaternions], np.int64)
         drive_q = np.array([d[1] for d in self._time_inputs], np.int64)

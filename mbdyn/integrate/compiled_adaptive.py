@@ -127,9 +127,9 @@ class _Stretches:
                           stacklevel=4)
             self.rtol = 100 * np.finfo(float).eps
         self.t, self.y = plan.t0, plan.y0.copy()
+        self.args = model.loop_arguments(plan.rhs.method)
         self.f, self.h_abs = self._first_step()
         self.start_evaluations = plan.rhs.evaluations
-        self.args = model.loop_arguments(plan.rhs.method)
         self.dense_args = self.args[:2] + self.args[3:]   # dense_step takes no quaternions
         self._start_samples()
         self.g_old = (event_values(plan.events, model, plan.t0, plan.y0) if plan.events
@@ -143,7 +143,22 @@ class _Stretches:
                      else STRETCH_MOST)
 
     def _derivative(self, t, y):
+        """``y'`` at ``(t, y)``: without drives by the stretches' own compiled stage
+        (``kernels.adaptive.stage``, the same arguments: no entry point of its own to
+        compile), else by ``Model.state_derivative`` (drives evaluated in Python, as
+        before: the same numbers); an evaluation that fails is repeated there, which
+        raises the precise error."""
         self.plan.rhs.evaluations += 1
+        if not self.model._time_inputs:
+            from ..kernels.adaptive import stage
+            from ..kernels.programs import STACK
+            nq, slots, _, free_q, free_u, drive_q, drive_u, *arrays = self.args
+            ydot = np.empty(y.size)
+            status = stage(float(t), y, *self.programs, np.empty(STACK), np.empty((0, 3)), nq,
+                           slots, free_q, free_u, drive_q, drive_u, *arrays, ydot,
+                           np.zeros(1, np.int64))
+            if not status:
+                return ydot
         return self.model.state_derivative(t, y, self.plan.rhs.method)
 
     def _first_step(self):

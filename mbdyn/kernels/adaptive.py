@@ -31,7 +31,7 @@ from numba import njit
 from .events import step_ends_stretch
 from .integrators import _rhs, finish_step
 from .programs import STACK, drive_values
-from .views import untracked
+from .views import UNCOUNTED, untracked
 
 RK45, DOP853 = 0, 1
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
@@ -178,14 +178,28 @@ TABLEAUS = {
 }
 
 
-@njit(cache=True, inline="always")
-def _stage(t, y, ops, consts, starts, stack, dv, nq, slots, free_q, free_u, drive_q, drive_u,
-           tree, body, loads, ws, ydot, nfev):
-    """The right-hand side at time ``t`` (drives evaluated there) and state ``y``."""
+@njit(**UNCOUNTED)
+def stage(t, y, ops, consts, starts, stack, dv, nq, slots, free_q, free_u, drive_q, drive_u,
+          tree, body, loads, ws, ydot, nfev):
+    """The right-hand side at time ``t`` (drives evaluated there) and state ``y``: every
+    stage of ``rk_stretch`` and of ``dense_step``, and, called from Python with the same
+    argument types (so compiled once for both), a run's first derivatives
+    (``integrate.compiled_adaptive``).  A function of its own, not inlined into each
+    stage's place: numba compiled the right-hand side five times over in ``rk_stretch``
+    (13 s of its first run instead of 8), and the call costs nothing measurable."""
     if dv.shape[0]:
         drive_values(ops, consts, starts, t, stack, dv)
     return _rhs(y, dv, nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads, ws,
                 ydot, nfev)
+
+
+@njit(cache=True, inline="always")
+def _failed(t, y, fail):
+    """``fail = [t, y]``: a failing stage's time and state (element by element: an array
+    assignment makes numba compile its shape-mismatch message, seconds of a first run)."""
+    fail[0] = t
+    for i in range(y.shape[0]):
+        fail[1 + i] = y[i]
 
 
 @njit(cache=True, inline="always")
@@ -209,11 +223,10 @@ def _dense_coefficients(A, C, D, stages, t_old, y_old, y_new, h, K, F, tmp, ops,
     ``K[:stages]``; computes the extra stages ``K[stages:]`` first (DOP853: three)."""
     for s in range(stages, K.shape[0]):
         _combine(y_old, h, A, s, K, tmp)
-        st = _stage(t_old + C[s] * h, tmp, ops, consts, starts, stack, dv, nq, slots, free_q,
+        st = stage(t_old + C[s] * h, tmp, ops, consts, starts, stack, dv, nq, slots, free_q,
                     free_u, drive_q, drive_u, tree, body, loads, ws, K[s], nfev)
         if st:
-            fail[0] = t_old + C[s] * h
-            fail[1:] = tmp
+            _failed(t_old + C[s] * h, tmp, fail)
             return st
     n = y_old.shape[0]
     f_new = K[stages - 1]
@@ -304,23 +317,21 @@ def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_s
             st = 0
             for s in range(1, stages - 1):
                 _combine(y, h, A, s, K, tmp)
-                st = _stage(t + C[s] * h, tmp, ops, consts, starts, stack, dv, nq, slots,
+                st = stage(t + C[s] * h, tmp, ops, consts, starts, stack, dv, nq, slots,
                             free_q, free_u, drive_q, drive_u, tree, body, loads, ws, K[s],
                             nfev)
                 if st:
-                    fail[0] = t + C[s] * h
-                    fail[1:] = tmp
+                    _failed(t + C[s] * h, tmp, fail)
                     return accepted, st, h_abs, i_eval
             for i in range(n):
                 acc = 0.0
                 for j in range(stages - 1):
                     acc += B[j] * K[j, i]
                 y_new[i] = y[i] + h * acc
-            st = _stage(t_new, y_new, ops, consts, starts, stack, dv, nq, slots, free_q,
+            st = stage(t_new, y_new, ops, consts, starts, stack, dv, nq, slots, free_q,
                         free_u, drive_q, drive_u, tree, body, loads, ws, K[stages - 1], nfev)
             if st:
-                fail[0] = t_new
-                fail[1:] = y_new
+                _failed(t_new, y_new, fail)
                 return accepted, st, h_abs, i_eval
             # error norm
             if kind == RK45:
@@ -379,12 +390,11 @@ def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_s
             st = finish_step(y_new, dv, nq, slots, quats, free_q, free_u, drive_q, drive_u,
                              tree, ws)
             if st == 0:
-                st = _stage(t_new, y_new, ops, consts, starts, stack, dv, nq, slots, free_q,
+                st = stage(t_new, y_new, ops, consts, starts, stack, dv, nq, slots, free_q,
                             free_u, drive_q, drive_u, tree, body, loads, ws, K[stages - 1],
                             nfev)
             if st:
-                fail[0] = t_new
-                fail[1:] = y_new
+                _failed(t_new, y_new, fail)
                 return accepted, st, h_abs, i_eval
         if keep_stages:
             row = min(accepted, keep_stages - 1)
@@ -396,7 +406,8 @@ def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_s
             f[i] = K[stages - 1, i]
         t = t_new
         out_t[accepted] = t
-        out_y[accepted] = y
+        for i in range(n):
+            out_y[accepted, i] = y[i]
         out_h[accepted] = h
         out_nfev[accepted] = nfev[0]
         out_ieval[accepted] = i_eval
@@ -413,7 +424,9 @@ def dense_step(A, C, D, stages, t_old, y_old, y_new, h, K_step, ops, consts, sta
     (``out_K[k]`` of ``rk_stretch``); returns ``(F, status)``."""
     n = y_old.shape[0]
     K = np.zeros((A.shape[0], n))
-    K[:stages] = K_step[:stages]
+    for s in range(stages):
+        for i in range(n):
+            K[s, i] = K_step[s, i]
     F = np.empty((3 + D.shape[0], n))
     tmp = np.empty(n)
     fail = np.empty(n + 1)

@@ -118,9 +118,11 @@ def project_state(y, nq, slots, quats, free_q, free_u, tree, state, motion, con,
     return steps
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=True)
 def project_state_call(y, nq, slots, quats, free_q, free_u, tree, state, motion, con, scratch):
-    """``project_state`` as a compiled entry point for Python (one state)."""
+    """``project_state`` as a compiled entry point, for Python (one state) and the compiled
+    loops (``routes.finish_step``).  Counted, explicitly: it allocates, and a callee
+    inherits an uncounted caller's mode."""
     return project_state(y, nq, slots, quats, free_q, free_u, tree, state, motion, con,
                          scratch)
 
@@ -139,9 +141,10 @@ def constraint_state(tree, state, motion, con, scratch):
                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=True)
 def constrained_call(tree, body, state, loads, motion, jourdain, con, scratch):
-    """``constrained_accelerations`` as a compiled entry point for Python."""
+    """``constrained_accelerations`` as a compiled entry point, for Python and the compiled
+    loops (``routes.accelerations``); counted, explicitly, as ``project_state_call``."""
     return constrained_accelerations(tree, body, state, loads, motion, jourdain, con,
                                      scratch)
 

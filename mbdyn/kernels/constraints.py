@@ -121,7 +121,7 @@ def constraint_count(con_int):
     return int(sum(ROWS[k] for k in con_int[:, 0])) if len(con_int) else 0
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=True)   # allocates: counted even under an uncounted caller
 def constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma):
     """Fill the residuals ``phi`` (positions), ``psi`` (their rates), the Jacobian ``G``

@@ -1,4 +1,5 @@
-"""Entry points compiled for one signature: the calls from Python that must cost little.
+"""Entry points compiled for one signature: the low-level calls from Python that must cost
+little (``compiled.lowlevel``).
 
 numba checks every argument of a compiled function at each call; a function compiled for
 one explicit signature (contiguous, writable float64 arrays and the packed model's integer
@@ -8,7 +9,10 @@ compiling for it.  Each entry checks the sizes before it touches the buffers (re
 degree of freedom has no inertia, -2 for a non-finite result.
 
 The integer buffer ``ib`` starts with the offset table (``packed.pack``) and stands for it:
-one array less to type and unbox at every call.
+one array less to type and unbox at every call; the force table is its view
+(``packed.force_table``), so the entries are compiled with the force kernel.  The ordinary
+``Model`` methods call the packed kernels themselves, with ``None`` for a model without
+force elements (a first call compiles less).
 """
 from numba import njit
 
@@ -44,7 +48,7 @@ def inverse_dynamics(fb, ib, q, u, ud, tau):
     nu = ib[1]
     if q.shape[0] != ib[7] or u.shape[0] != nu or ud.shape[0] != nu or tau.shape[0] != nu:
         return WRONG_SIZE
-    return ki.inverse_dynamics_packed(fb, ib, ib, q, u, ud, tau)
+    return ki.inverse_dynamics_packed(fb, ib, ib, kp.force_table(ib, ib), q, u, ud, tau)
 
 
 def mass_matrix(fb, ib, q, M):
@@ -52,7 +56,7 @@ def mass_matrix(fb, ib, q, M):
     nu = ib[1]
     if q.shape[0] != ib[7] or M.shape[0] != nu or M.shape[1] != nu:
         return WRONG_SIZE
-    return ki.mass_matrix_packed(fb, ib, ib, q, M)
+    return ki.mass_matrix_packed(fb, ib, ib, None, q, M)
 
 
 @njit(inline="always", **UNCOUNTED)
@@ -62,7 +66,7 @@ def _forward(accelerations, fb, ib, q, u, out):
     nu = ib[1]
     if q.shape[0] != ib[7] or u.shape[0] != nu or out.shape[0] != nu:
         return WRONG_SIZE
-    status = accelerations(fb, ib, ib, q, u)
+    status = accelerations(fb, ib, ib, kp.force_table(ib, ib), q, u)
     ud = c_view(fb, ib[kp.UD], (nu,))
     for k in range(nu):
         out[k] = ud[k]

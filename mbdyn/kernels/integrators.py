@@ -154,16 +154,20 @@ def _scratch(ny):
 
 # One compiled loop per scheme, so that a run compiles only its own scheme's step (a loop
 # over all four would compile all of them: about 9 s of a first run).  The loops differ
-# only in the step they call.  After each step they check the run's event conditions
+# only in the step they call.  They release the GIL (``nogil``): batched ensembles run
+# them on threads (``kernels.batched``).  After each step they check the run's event conditions
 # (``kernels.events``; ``times[n]``: the time after step ``n``) and return early, status 0,
 # after a step where a terminal one crossed zero or one is not finite.  Unless ``dout`` is
 # empty, ``dout[n]`` receives ``y'`` at the start of step ``n`` (``k1``, which every step
 # computes anyway): the derivatives of the cubic Hermite dense output (``samples``).
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, drive_u,
                tree, body, loads, ws, out, dout, nfev, times, events):
-    """``fixed_step_loop`` with explicit Euler."""
+    """Run ``out.shape[0] - 1`` steps of size ``h`` of explicit Euler from ``y0``;
+    ``out[k]`` is the state after k steps.  ``drive_table[k, s]`` holds the drives'
+    ``(q, q', q'')`` at stage time ``t_k + STAGES[s] h``; ``nfev[0]`` counts
+    right-hand-side evaluations.  Returns ``(steps done, status)``."""
     _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
     tree, body, loads, ws = untracked(tree), untracked(body), untracked(loads), untracked(ws)
@@ -185,10 +189,10 @@ def euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, dr
     return out.shape[0] - 1, 0
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def semi_implicit_euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q,
                              drive_u, tree, body, loads, ws, out, dout, nfev, times, events):
-    """``fixed_step_loop`` with semi-implicit Euler."""
+    """``euler_loop`` with semi-implicit Euler."""
     _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
     tree, body, loads, ws = untracked(tree), untracked(body), untracked(loads), untracked(ws)
@@ -211,10 +215,10 @@ def semi_implicit_euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_
     return out.shape[0] - 1, 0
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def rk4_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, drive_u, tree,
              body, loads, ws, out, dout, nfev, times, events):
-    """``fixed_step_loop`` with RK4."""
+    """``euler_loop`` with RK4."""
     _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
     tree, body, loads, ws = untracked(tree), untracked(body), untracked(loads), untracked(ws)
@@ -236,10 +240,10 @@ def rk4_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, driv
     return out.shape[0] - 1, 0
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def implicit_midpoint_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q,
                            drive_u, tree, body, loads, ws, out, dout, nfev, times, events):
-    """``fixed_step_loop`` with the implicit midpoint rule."""
+    """``euler_loop`` with the implicit midpoint rule."""
     _copy(y0, out[0])
     k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
     tree, body, loads, ws = untracked(tree), untracked(body), untracked(loads), untracked(ws)
@@ -265,45 +269,6 @@ def implicit_midpoint_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u,
 #: the compiled loop of each scheme code
 LOOPS = {EULER: euler_loop, SEMI_IMPLICIT_EULER: semi_implicit_euler_loop, RK4: rk4_loop,
          IMPLICIT_MIDPOINT: implicit_midpoint_loop}
-
-
-@njit(cache=True)
-def fixed_step_loop(scheme, h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q,
-                    drive_u, tree, body, loads, ws, out, nfev):
-    """Run ``out.shape[0] - 1`` steps of size ``h`` from ``y0``; ``out[k]`` is the state
-    after k steps.  ``drive_table[k, s]`` holds the drives' ``(q, q', q'')`` at stage time
-    ``t_k + STAGES[s] h``; ``nfev[0]`` counts right-hand-side evaluations.
-    Returns ``(steps done, status)``.
-
-    The scheme is chosen at run time (for ``kernels.batched``), so this compiles all four
-    steps; a single run calls its scheme's loop in ``LOOPS``, which does the same steps."""
-    _copy(y0, out[0])
-    k1, k2, k3, k4, tmp, J = _scratch(y0.shape[0])
-    tree, body, loads, ws = untracked(tree), untracked(body), untracked(loads), untracked(ws)
-    out, drive_table = untracked(out), untracked(drive_table)
-    for n in range(out.shape[0] - 1):
-        y, yn, drives = out[n], out[n + 1], drive_table[n]
-        if scheme == EULER:
-            st = euler_step(h, y, yn, drives, nq, slots, free_q, free_u, drive_q, drive_u,
-                            tree, body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
-        elif scheme == SEMI_IMPLICIT_EULER:
-            st = semi_implicit_euler_step(h, y, yn, drives, nq, slots, free_q, free_u,
-                                          drive_q, drive_u, tree, body, loads, ws, k1, k2, k3,
-                                          k4, tmp, J, nfev)
-        elif scheme == RK4:
-            st = rk4_step(h, y, yn, drives, nq, slots, free_q, free_u, drive_q, drive_u, tree,
-                          body, loads, ws, k1, k2, k3, k4, tmp, J, nfev)
-        else:
-            st = midpoint_step(h, y, yn, drives, nq, slots, free_q, free_u, drive_q,
-                                         drive_u, tree, body, loads, ws, k1, k2, k3, k4, tmp, J,
-                                         nfev)
-        if st:
-            return n, st
-        st = finish_step(yn, drives[2], nq, slots, quats, free_q, free_u, drive_q, drive_u,
-                         tree, ws)
-        if st:
-            return n, st
-    return out.shape[0] - 1, 0
 
 
 @njit(cache=True)

@@ -135,15 +135,16 @@ def composite_mass_matrix_s(mass, com, inertia, parent, kind, ucol, R, r, S, IC,
 # The entries on the packed buffers (``packed``): one compiled call each.
 
 @njit(**UNCOUNTED)
-def inverse_dynamics_packed(fb, ib, t, q, u, ud, tau):
+def inverse_dynamics_packed(fb, ib, t, forces, q, u, ud, tau):
     """Scatter ``q``, ``u``, ``u'``; the kinematics with those rates and the applied loads;
     then ``recursive_newton_euler``: ``tau`` (free speeds) and the joint wrenches in the
-    ``W`` view.  Returns -1, or -2 when ``tau`` holds NaN or Inf."""
+    ``W`` view.  ``forces``: the force table or None (``packed``).  Returns -1, or -2 when
+    ``tau`` holds NaN or Inf."""
     _scatter(fb, ib, t, q, u)
     udfull, free_u = fb[t[UDFULL]:], ib[t[FREE_U]:]
     for k in range(ud.shape[0]):
         udfull[free_u[k]] = ud[k]
-    tree, body, state, loads, _, motion, _, art, scratch = _views(fb, ib, t)
+    tree, body, state, loads, _, motion, _, art, scratch = _views(fb, ib, t, forces)
     mass, com, inertia, _, gravity = body
     parent, kind, axis, seq, pos, C, qoff, uoff, ucol = tree[:9]
     anc_ptr, anc_idx = art[0], art[1]            # empty: the kinematics fill S only
@@ -165,12 +166,13 @@ def inverse_dynamics_packed(fb, ib, t, q, u, ud, tau):
 
 
 @njit(**UNCOUNTED)
-def mass_matrix_packed(fb, ib, t, q, M):
+def mass_matrix_packed(fb, ib, t, forces, q, M):
     """Scatter ``q`` (speeds zero), the kinematics, then ``composite_mass_matrix_s`` into
-    ``M`` (nu x nu).  Returns -1, or -2 when ``M`` holds NaN or Inf."""
+    ``M`` (nu x nu); ``forces`` is not read (the packed kernels' arguments).  Returns -1,
+    or -2 when ``M`` holds NaN or Inf."""
     ufull, free_u = fb[t[UFULL]:], ib[t[FREE_U]:]
     nu = t[1]
-    tree, body, state, _, _, motion, _, art, scratch = _views(fb, ib, t)
+    tree, body, state, _, _, motion, _, art, scratch = _views(fb, ib, t, None)
     qfull = state[0]
     free_q = ib[t[FREE_Q]:]
     for k in range(q.shape[0]):

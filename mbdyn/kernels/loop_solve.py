@@ -29,7 +29,7 @@ PASSAGE_TOLERANCE = 1e-6
 ROWS = 5
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=True)   # allocates: counted even under an uncounted caller
 def constrained_solve(M, L, ud, G, gamma, lam, info):
     """``ud`` (holding ``M^-1 f`` on entry, ``L`` the Cholesky factor of ``M``) corrected
     to the constrained accelerations; ``lam`` the minimum-norm multipliers.  ``info[0]``:
@@ -243,7 +243,7 @@ def _chosen_rows_solve(L, ud, G, gamma, lam, info, r, Y, A, res, x, z):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=True)   # allocates: counted even under an uncounted caller
 def min_norm_step(G, rhs, keep, du, info):
     """``du``: the minimum-norm solution of ``G du = rhs`` -- by ``G^T (G G^T)^+ rhs`` on
     the rows a pivoted Cholesky of ``G G^T`` keeps (``keep`` at most) during a run, by
@@ -287,7 +287,7 @@ def _min_norm_pivoted(G, rhs, keep, du, info, work):
     return A[rank - 1, rank - 1] / A[0, 0] if rank else 1.0
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=True)   # allocates: counted even under an uncounted caller
 def augmented_solve(M, f, G, gamma, ud, lam, info):
     """The same equations as one least-squares system ``[[M, G^T], [G, 0]] [u', -lam] =
     [f, gamma]`` (minimum norm): for a mass matrix that is only semi-definite.  Returns
@@ -327,7 +327,7 @@ def augmented_solve(M, f, G, gamma, ud, lam, info):
 
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=True)   # allocates: counted even under an uncounted caller
 def rank_of(G):
     """``(rank, conditioning)``: the singular values of ``G`` above ``RANK_TOLERANCE`` of
     the largest, and the smallest of them over the largest."""

@@ -12,6 +12,12 @@ The Jourdain entry points also scatter the free coordinates and speeds into the 
 state (what ``Model._fill`` does in Python for the other evaluations); drives and loads
 given as Python functions are still written by the caller first.
 
+Every packed kernel takes, after the offset table, the model's force-element table
+``forces`` (``force_int``, a view of the integer buffer) or ``None`` for a model without
+force elements: a type, not a count, so that the kernels are compiled for such a model
+without the force kernel (``evaluate.kinematics_and_loads``), as the compiled loops are.
+``Model._packed`` holds the four, so that a call reads ``kernel(*model._packed, q, u)``.
+
 The arrays only the Jourdain and dense Newton-Euler routes read, O(n nu) and O(nu^2),
 are not in the buffers (``FAR``): allocated on the first use of such a route, they are
 entered into the offset table by address (``place``), so that the buffers, and every view
@@ -117,7 +123,14 @@ def place(table, far):
 
 
 @njit(inline="always", **UNCOUNTED)
-def _views(fb, ib, t):
+def force_table(ib, t):
+    """The force-element table ``force_int`` as a view of the integer buffer (for a caller
+    that has only the buffers, e.g. ``compiled.lowlevel``)."""
+    return c_view(ib, t[FORCE_INT], (t[9], ROW))
+
+
+@njit(inline="always", **UNCOUNTED)
+def _views(fb, ib, t, forces):
     """Every packed array as a view, in the order of the unpacked kernels' arguments:
     tree (11), body (mass, com, inertia, has_inertia, gravity), joint-space state (3),
     loads (5, then force elements and effect switches: 3), reactions (3), motion (11),
@@ -126,7 +139,7 @@ def _views(fb, ib, t):
     ``articulated.articulated_body`` and the joint wrenches and reaction components), and
     the evaluations' scratch.  Offsets and addresses are read from ``t`` at run time:
     literal constants as arguments would make numba compile a slicing helper per
-    constant."""
+    constant.  ``forces`` is the loads' force table as given (an array, or ``None``)."""
     n, nu, nl, nqf, nuf, nanc, nreact = t[0], t[1], t[2], t[3], t[4], t[5], t[6]
     nj, nm = t[NJ], t[NM]
     fb, ib = untracked(fb), untracked(ib)       # slices of them are untracked too
@@ -146,8 +159,7 @@ def _views(fb, ib, t):
              c_view(fb, t[LOAD_POINT], (nl, 3)),
              c_view(fb, t[LOAD_FORCE], (nl, 3)),
              c_view(fb, t[LOAD_MOMENT], (nl, 3)),
-             ib[t[LOAD_IN_BODY]:t[LOAD_IN_BODY] + nl],
-             c_view(ib, t[FORCE_INT], (t[9], ROW)),
+             ib[t[LOAD_IN_BODY]:t[LOAD_IN_BODY] + nl], forces,
              fb[t[FORCE_DATA]:t[FORCE_DATA] + t[10]], ib[t[SWITCHES]:t[SWITCHES] + 1])
     reactions = (ib[t[REACT_JOINT]:t[REACT_JOINT] + nreact],
                  c_view(fb, t[REACT_FORCE], (nreact, 3)),
@@ -190,21 +202,21 @@ def _scatter(fb, ib, t, q, u):
 
 
 @njit(**UNCOUNTED)
-def jourdain_accelerations_packed(fb, ib, t, q, u):
+def jourdain_accelerations_packed(fb, ib, t, forces, q, u):
     """Scatter ``q``, ``u``, then ``evaluate.jourdain_accelerations`` on packed arrays (same
     return value; ``u'`` is left in the ``ud`` view)."""
     _scatter(fb, ib, t, q, u)
-    tree, body, state, loads, _, motion, jourdain, _, scratch = _views(fb, ib, t)
+    tree, body, state, loads, _, motion, jourdain, _, scratch = _views(fb, ib, t, forces)
     return jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch)
 
 
 @njit(**UNCOUNTED)
-def state_derivative_packed(fb, ib, t, y, ydot):
+def state_derivative_packed(fb, ib, t, forces, y, ydot):
     """``ydot = [N(q) u, u']`` for ``y = [q, u]``.  Returns -1, the pivot where the
     Cholesky factorization of ``M`` broke down, or -2 when ``ydot`` holds NaN or Inf."""
     nq = t[7]
     _scatter(fb, ib, t, y[:nq], y[nq:])
-    tree, body, state, loads, _, motion, jourdain, _, scratch = _views(fb, ib, t)
+    tree, body, state, loads, _, motion, jourdain, _, scratch = _views(fb, ib, t, forces)
     pivot = jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch)
     if pivot >= 0:
         return pivot
@@ -227,13 +239,13 @@ def _state_rates(fb, ib, t, y, ydot):
 
 
 @njit(cache=True)
-def newton_euler_solution_packed(fb, ib, t, q, u, A, b):
+def newton_euler_solution_packed(fb, ib, t, forces, q, u, A, b):
     """Scatter ``q``, ``u``, then ``evaluate.newton_euler_solution`` on packed arrays, the
     dense system in ``A`` (6n x 6n) and ``b`` (6n): they are not in the packed buffers,
     being O(n^2) and needed by this route only (``Model._dense_system``).  Returns the
     unknowns ``x = [ud, lambda]`` (a new array) and whether all are finite."""
     _scatter(fb, ib, t, q, u)
-    tree, body, state, loads, reactions, motion, _, _, scratch = _views(fb, ib, t)
+    tree, body, state, loads, reactions, motion, _, _, scratch = _views(fb, ib, t, forces)
     mass, com, inertia, _, gravity = body
     x = newton_euler_solution(*tree, mass, com, inertia, gravity, *state, *loads,
                               *reactions, *motion, A, b, scratch)
@@ -244,32 +256,33 @@ def newton_euler_solution_packed(fb, ib, t, q, u, A, b):
 
 
 @njit(**UNCOUNTED)
-def articulated_accelerations_packed(fb, ib, t, q, u):
+def articulated_accelerations_packed(fb, ib, t, forces, q, u):
     """Scatter ``q``, ``u``, then ``evaluate.articulated_accelerations`` on packed arrays
     (same return value; ``u'`` is left in the ``ud`` view)."""
     _scatter(fb, ib, t, q, u)
-    tree, body, state, loads, _, motion, jourdain, art, scratch = _views(fb, ib, t)
+    tree, body, state, loads, _, motion, jourdain, art, scratch = _views(fb, ib, t, forces)
     mass, com, inertia, _, gravity = body
     return articulated_accelerations(tree[:9] + art[:2], (mass, com, inertia, gravity), state,
                                      loads, motion, art[2:8], jourdain[3], scratch)
 
 
 @njit(**UNCOUNTED)
-def state_derivative_articulated_packed(fb, ib, t, y, ydot):
+def state_derivative_articulated_packed(fb, ib, t, forces, y, ydot):
     """``state_derivative_packed`` with ``u'`` by the articulated-body algorithm."""
     nq = t[7]
-    pivot = articulated_accelerations_packed(fb, ib, t, y[:nq], y[nq:])
+    pivot = articulated_accelerations_packed(fb, ib, t, forces, y[:nq], y[nq:])
     if pivot >= 0:
         return pivot
     return _state_rates(fb, ib, t, y, ydot)
 
 
 @njit(**UNCOUNTED)
-def newton_euler_tree_packed(fb, ib, t, q, u):
+def newton_euler_tree_packed(fb, ib, t, forces, q, u):
     """Scatter ``q``, ``u``, then ``evaluate.newton_euler_tree`` on packed arrays: ``u'``
     in the ``ud`` view, the reaction components in ``lam``; same return value."""
     _scatter(fb, ib, t, q, u)
-    tree, body, state, loads, reactions, motion, jourdain, art, scratch = _views(fb, ib, t)
+    tree, body, state, loads, reactions, motion, jourdain, art, scratch = _views(fb, ib, t,
+                                                                                 forces)
     mass, com, inertia, _, gravity = body
     return newton_euler_tree(*tree[:9], *art[:2], mass, com, inertia, gravity, *state, *loads,
                              *reactions, *motion, *art[2:9], jourdain[3], art[9], scratch)

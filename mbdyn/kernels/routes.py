@@ -3,12 +3,16 @@ of the model's workspace ``ws`` (``Model.loop_arguments``): the accelerations by
 Jourdain's ``M u' = f``, by the articulated bodies, or of a closed mechanism (``M u' = f +
 G^T lam``, ``G u' = gamma``), and what follows each step (unit quaternions; for a closed
 mechanism, the projection onto its constraints).  A run compiles only its own route.
+
+Each route is a function the loops call, compiled once (uncounted, as the kernels it
+calls), not inlined: numba compiles the implementation of an inlined overload as a
+function anyway, and then again inside every caller.
 """
 import numpy as np
 from numba import njit
 from numba.extending import overload
 
-from .constrained import constrained_accelerations, project_state
+from .constrained import constrained_call, project_state_call
 from .evaluate import articulated_accelerations, jourdain_accelerations
 
 
@@ -27,20 +31,22 @@ def accelerations(tree, body, loads, ws, ud):
     raise NotImplementedError("compiled code only")
 
 
-@overload(accelerations, inline="always")
+@overload(accelerations, jit_options={"_nrt": False})
 def _accelerations_route(tree, body, loads, ws, ud):
     """The formulation is chosen when the loop is compiled, by the workspace's type: 18
     arrays (``M``, ``f``, ``L``, scratch last) for ``M u' = f``, 26 (the same and the
     eight arrays of the constraints, ``Model._con``) for a closed mechanism, 21 (the articulated-body
     workspace, then the scratch; ``tree`` then has empty ancestor lists) for the
-    articulated-body algorithm.  A run compiles only its own route."""
+    articulated-body algorithm.  A run compiles only its own route.  A closed mechanism's
+    route calls the entry points Python calls (``constrained_call``,
+    ``project_state_call``): compiled once for both, and counted (they allocate)."""
     if len(ws) == 26:
         def constrained_route(tree, body, loads, ws, ud):
             (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S, F, N, M, f, L,
              scratch) = ws[:18]
-            return constrained_accelerations(tree, body, (qfull, ufull, udfull), loads,
-                                             (R, r, w, v, alpha, a, JR, JT, S, F, N),
-                                             (M, f, L, ud), ws[18:], scratch)
+            return constrained_call(tree, body, (qfull, ufull, udfull), loads,
+                                    (R, r, w, v, alpha, a, JR, JT, S, F, N), (M, f, L, ud),
+                                    ws[18:], scratch)
         return constrained_route
     if len(ws) == 18:
         def jourdain_route(tree, body, loads, ws, ud):
@@ -69,7 +75,7 @@ def finish_step(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_
     raise NotImplementedError("compiled code only")
 
 
-@overload(finish_step, inline="always")
+@overload(finish_step, jit_options={"_nrt": False})
 def _finish_step_route(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_u,
                        tree, ws):
     """Chosen by the workspace's layout, as ``accelerations``: a tree only normalises."""
@@ -82,8 +88,8 @@ def _finish_step_route(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q,
                 ufull[drive_u[d]] = drive_vals[d, 1]
                 udfull[drive_u[d]] = drive_vals[d, 2]
             _normalize(y, quats)
-            steps = project_state(y, nq, slots, quats, free_q, free_u, tree,
-                                  (qfull, ufull, udfull), ws[3:14], ws[18:], ws[17])
+            steps = project_state_call(y, nq, slots, quats, free_q, free_u, tree,
+                                       (qfull, ufull, udfull), ws[3:14], ws[18:], ws[17])
             return 5 if steps < 0 else 0
         return project_route
 

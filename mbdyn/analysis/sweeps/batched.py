@@ -40,6 +40,7 @@ def batchable(scene, quantities):
 def run_batched(scenes, quantities):
     """Rows of members that share one compiled model (their scenes differ only in the
     initial state), advanced together by ``kernels.batched.batched_fixed_step``."""
+    from ...compiled.programs import EventPrograms
     from ...integrate.fixed_step import step_plan
     from ...kernels.batched import batched_fixed_step
     from ...kernels.integrators import SCHEMES, STAGES
@@ -66,7 +67,7 @@ def run_batched(scenes, quantities):
     # every compiled loop
     batched_fixed_step(SCHEMES[s["integrator"]], dt, n_full, h_last, Y0, table, last,
                        *model.loop_arguments(model.formulation(s["method"])), Yend, done,
-                       status, nfev)
+                       status, nfev, EventPrograms.none())
     all_times = np.append(times, t_end) if h_last else times
     rows = []
     for i, sc in enumerate(scenes):
