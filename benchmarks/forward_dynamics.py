@@ -202,7 +202,8 @@ def measure(cases, budget, repeats, ratios=()):
 # ----------------------------------------------------------------------------- raw kernels
 def packed_args(model, q, u):
     """The arguments ``Model.forward_dynamics`` passes to the packed Jourdain kernel: the
-    float buffer, the integer buffer, the offset table (``mbdyn.kernels.packed``), q, u."""
+    float buffer, the integer buffer, the offset table, the force table or None
+    (``mbdyn.kernels.packed``), q, u."""
     return (*model._packed, np.asarray(q, float), np.asarray(u, float))
 
 
@@ -210,8 +211,9 @@ _PACKED = {}
 
 
 def packed_helpers(kernel):
-    """``nop(fb, ib, t, q, u)``: zeroes the packed ``ud`` and returns -1 at once (its call
-    cost is numba's dispatch for the five arguments); ``loop(count, fb, ib, t, q, u)``:
+    """``nop(fb, ib, t, forces, q, u)``: zeroes the packed ``ud`` and returns -1 at once (its
+    call cost is numba's dispatch for the six arguments); ``loop(count, fb, ib, t, forces,
+    q, u)``:
     calls ``kernel`` ``count`` times from compiled code (its compute time without
     dispatch)."""
     if kernel not in _PACKED:
@@ -220,16 +222,16 @@ def packed_helpers(kernel):
         UD = kp.UD
 
         @njit
-        def nop(fb, ib, t, q, u):
+        def nop(fb, ib, t, forces, q, u):
             fb[t[UD]:t[UD] + t[1]] = 0.0
             return -1
 
         loop = None
         if kernel is not None:
             @njit
-            def loop(count, fb, ib, t, q, u):
+            def loop(count, fb, ib, t, forces, q, u):
                 for _ in range(count):
-                    kernel(fb, ib, t, q, u)   # writes its outputs: cannot be elided
+                    kernel(fb, ib, t, forces, q, u)   # writes its outputs: not elided
                 return count
         _PACKED[kernel] = (nop, loop)
     return _PACKED[kernel]
