@@ -40,7 +40,7 @@ PROJECTION_TOLERANCE = 1e-13
 PROJECTION_ITERATIONS = 12
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=True)
 def constrained_solve(M, L, ud, G, gamma, lam, info):
     """``ud`` (holding ``M^-1 f`` on entry, ``L`` the Cholesky factor of ``M``) corrected
     to the constrained accelerations; ``lam`` the minimum-norm multipliers.  ``info[0]``:
@@ -228,7 +228,7 @@ def min_norm_step(G, rhs, keep, du):
     return A[rank - 1, rank - 1] / A[0, 0] if rank else 1.0
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=True)
 def augmented_solve(M, f, G, gamma, ud, lam, info):
     """The same equations as one least-squares system ``[[M, G^T], [G, 0]] [u', -lam] =
     [f, gamma]`` (minimum norm): for a mass matrix that is only semi-definite.  Returns
@@ -393,8 +393,9 @@ def constraint_state(tree, state, motion, con, scratch):
 
 @njit(cache=True, _nrt=True)
 def constrained_call(tree, body, state, loads, motion, jourdain, con, scratch):
-    """``constrained_accelerations`` as a compiled entry point, for Python and the compiled
-    loops (``routes.accelerations``); counted, explicitly, as ``project_state_call``."""
+    """``constrained_accelerations`` as a compiled entry point for Python (the compiled
+    loops inline it: ``routes.accelerations``); counted, explicitly, as
+    ``project_state_call``."""
     return constrained_accelerations(tree, body, state, loads, motion, jourdain, con,
                                      scratch)
 
