@@ -85,7 +85,8 @@ def reaction_uniqueness(model, q, t=0.0):
     zero = np.zeros((n, 3))
     for z in U[:, rank:].T:
         F, N = np.zeros((n, 3)), np.zeros((n, 3))
-        tree, loops = _wrenches(model, z, F, N, zero, zero, zero)
+        # (a contiguous copy: the kernel is compiled for contiguous multipliers)
+        tree, loops = _wrenches(model, np.ascontiguousarray(z), F, N, zero, zero, zero)
         for i, name in enumerate(model.joints):
             unique[name] &= np.abs(tree[i]) <= UNIQUE_TOLERANCE
         for name in names[len(model.joints):]:

@@ -143,8 +143,9 @@ def constraint_state(tree, state, motion, con, scratch):
 
 @njit(cache=True, _nrt=True)
 def constrained_call(tree, body, state, loads, motion, jourdain, con, scratch):
-    """``constrained_accelerations`` as a compiled entry point, for Python and the compiled
-    loops (``routes.accelerations``); counted, explicitly, as ``project_state_call``."""
+    """``constrained_accelerations`` as a compiled entry point for Python (the compiled
+    loops inline it: ``routes.accelerations``); counted, explicitly, as
+    ``project_state_call``."""
     return constrained_accelerations(tree, body, state, loads, motion, jourdain, con,
                                      scratch)
 

@@ -28,6 +28,7 @@ import numpy as np
 from numba import njit
 
 from .joints import REVOLUTE
+from .linalg3 import cross_to
 from .views import UNCOUNTED, c_view
 
 POINT, PERP, SLIDE, DIST, COUPLE = 0, 1, 2, 3, 4
@@ -35,13 +36,6 @@ POINT, PERP, SLIDE, DIST, COUPLE = 0, 1, 2, 3, 4
 ROWS = (3, 1, 1, 1, 1)
 #: floats of ``con_data`` per primitive
 DATA = 14
-
-
-@njit(cache=True, inline="always")
-def _cross(a, b, out):
-    out[0] = a[1] * b[2] - a[2] * b[1]
-    out[1] = a[2] * b[0] - a[0] * b[2]
-    out[2] = a[0] * b[1] - a[1] * b[0]
 
 
 @njit(cache=True, inline="always")
@@ -58,11 +52,11 @@ def _point(i, s, R, r, w, v, alpha, a, rho, P, vP, aP, t1, t2):
     for k in range(3):
         rho[k] = R[i, k, 0] * s[0] + R[i, k, 1] * s[1] + R[i, k, 2] * s[2]
         P[k] = r[i, k] + rho[k]
-    _cross(w[i], rho, t1)
-    _cross(w[i], t1, t2)
+    cross_to(w[i], rho, t1)
+    cross_to(w[i], t1, t2)
     for k in range(3):
         vP[k] = v[i, k] + t1[k]
-    _cross(alpha[i], rho, t1)
+    cross_to(alpha[i], rho, t1)
     for k in range(3):
         aP[k] = a[i, k] + t1[k] + t2[k]
 
@@ -189,7 +183,7 @@ def _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
             _vector(ip, A, R, va)
             _vector(ic, B, R, vb)
             # Phi' = (w_p x a).b + a.(w_c x b) = e.(w_c - w_p) with e = b x a
-            _cross(vb, va, axb)
+            cross_to(vb, va, axb)
             phi[row] = va[0] * vb[0] + va[1] * vb[1] + va[2] * vb[2]
             rate = 0.0
             for k in range(3):
@@ -199,10 +193,10 @@ def _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
             _add_rotation_row(G, Gabs, row, ip, axb, -1.0, JR)
             # Phi'' at u' = 0: e.(alpha_c - alpha_p) + e'.(w_c - w_p), with
             # e' = (w_c x b) x a + b x (w_p x a)
-            _cross(wc, vb, t1)
-            _cross(t1, va, t2)
-            _cross(wp, va, t1)
-            _cross(vb, t1, t3)
+            cross_to(wc, vb, t1)
+            cross_to(t1, va, t2)
+            cross_to(wp, va, t1)
+            cross_to(vb, t1, t3)
             acc = 0.0
             for k in range(3):
                 acc += axb[k] * (alc[k] - alp[k]) + (t2[k] + t3[k]) * (wc[k] - wp[k])
@@ -226,17 +220,17 @@ def _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
             row += 3
         elif kind == SLIDE:
             _vector(ip, A, R, va)                          # n, fixed in p
-            _cross(wp, va, t1)                             # n'
+            cross_to(wp, va, t1)                             # n'
             phi[row] = d[0] * va[0] + d[1] * va[1] + d[2] * va[2]
             psi[row] = (dv[0] * va[0] + dv[1] * va[1] + dv[2] * va[2]
                         + d[0] * t1[0] + d[1] * t1[1] + d[2] * t1[2])
             _add_point_row(G, Gabs, row, ic, rc, va, 1.0, JT, JR)
             _add_point_row(G, Gabs, row, ip, rp, va, -1.0, JT, JR)
-            _cross(va, d, t2)                              # d . (w_p x n) = w_p . (n x d)
+            cross_to(va, d, t2)                              # d . (w_p x n) = w_p . (n x d)
             _add_rotation_row(G, Gabs, row, ip, t2, 1.0, JR)
             # Phi'' at u' = 0: d''.n + 2 d'.n' + d.(alpha_p x n + w_p x n')
-            _cross(alp, va, t2)
-            _cross(wp, t1, t3)
+            cross_to(alp, va, t2)
+            cross_to(wp, t1, t3)
             acc = 0.0
             for k in range(3):
                 acc += (ac[k] - ap[k]) * va[k] + 2.0 * dv[k] * t1[k] + d[k] * (t2[k] + t3[k])
@@ -267,7 +261,7 @@ def _apply(ic, ip, P, f, mo, R, r, com, F, N, t1, lever):
         for k in range(3):
             t1[k] = com[i, 0] * R[i, k, 0] + com[i, 1] * R[i, k, 1] + com[i, 2] * R[i, k, 2]
             lever[k] = P[k] - r[i, k] - t1[k]          # centre of mass -> P
-        _cross(lever, f, t1)
+        cross_to(lever, f, t1)
         for k in range(3):
             F[i, k] += sign * f[k]
             N[i, k] += sign * (mo[k] + t1[k])
@@ -322,7 +316,7 @@ def constraint_wrenches(con_int, con_data, parent, kind_of, axis, R, r, lam, F, 
         elif kind == PERP:
             _vector(ip, con_data[m, 6:9], R, va)
             _vector(ic, con_data[m, 9:12], R, vb)
-            _cross(vb, va, t1)                  # the moment's axis: b x a (see PERP's rows)
+            cross_to(vb, va, t1)                  # the moment's axis: b x a (see PERP's rows)
             for k in range(3):
                 mo[k] = lam[row] * t1[k]
             row += 1

@@ -12,7 +12,7 @@ import numpy as np
 from numba import njit
 from numba.extending import overload
 
-from .constrained import constrained_call, project_state_call
+from .constrained import constrained_accelerations, project_state_call
 from .evaluate import articulated_accelerations, jourdain_accelerations
 
 
@@ -37,16 +37,17 @@ def _accelerations_route(tree, body, loads, ws, ud):
     arrays (``M``, ``f``, ``L``, scratch last) for ``M u' = f``, 26 (the same and the
     eight arrays of the constraints, ``Model._con``) for a closed mechanism, 21 (the articulated-body
     workspace, then the scratch; ``tree`` then has empty ancestor lists) for the
-    articulated-body algorithm.  A run compiles only its own route.  A closed mechanism's
-    route calls the entry points Python calls (``constrained_call``,
-    ``project_state_call``): compiled once for both, and counted (they allocate)."""
+    articulated-body algorithm.  A run compiles only its own route.  A closed
+    mechanism's accelerations are inlined here too (a call with their fifty arrays cost a
+    tenth of a four-bar's evaluation); the kernels they call that allocate are counted
+    explicitly (``constraint_rows``, the solves)."""
     if len(ws) == 26:
         def constrained_route(tree, body, loads, ws, ud):
             (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S, F, N, M, f, L,
              scratch) = ws[:18]
-            return constrained_call(tree, body, (qfull, ufull, udfull), loads,
-                                    (R, r, w, v, alpha, a, JR, JT, S, F, N), (M, f, L, ud),
-                                    ws[18:], scratch)
+            return constrained_accelerations(tree, body, (qfull, ufull, udfull), loads,
+                                             (R, r, w, v, alpha, a, JR, JT, S, F, N),
+                                             (M, f, L, ud), ws[18:], scratch)
         return constrained_route
     if len(ws) == 18:
         def jourdain_route(tree, body, loads, ws, ud):
@@ -78,7 +79,9 @@ def finish_step(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_
 @overload(finish_step, jit_options={"_nrt": False})
 def _finish_step_route(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_u,
                        tree, ws):
-    """Chosen by the workspace's layout, as ``accelerations``: a tree only normalises."""
+    """Chosen by the workspace's layout, as ``accelerations``: a tree only normalises; a
+    closed mechanism's projection is the entry point Python calls
+    (``constrained.project_state_call``, counted: it allocates), once a step."""
     if len(ws) == 26:
         def project_route(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_u,
                           tree, ws):
