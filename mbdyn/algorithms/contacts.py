@@ -100,6 +100,6 @@ def contact_forces(model, q, u, t=0.0, max_points=512):
     from ..kernels import forces as kf
     kf.force_elements(model._force_int, model._force_data, model._parent, model._axis,
                       model._com, model._qfull, model._ufull, model._R, model._r, model._w,
-                      model._v, model._F, model._N, acc, model._scratch)
+                      model._v, model._F, model._N, acc, model._scratch, model._force_shapes)
     n = min(int(acc[3]), int(max_points))
     return acc[kc.RECORDS:kc.RECORDS + 6 * n].reshape(n, 6).copy()

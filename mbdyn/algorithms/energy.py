@@ -53,7 +53,7 @@ def element_power(model, q, u, t=0.0):
     acc = np.zeros(3)
     kf.force_elements(model._force_int, model._force_data, model._parent, model._axis,
                       model._com, model._qfull, model._ufull, model._R, model._r, model._w,
-                      model._v, model._F, model._N, acc, model._scratch)
+                      model._v, model._F, model._N, acc, model._scratch, model._force_shapes)
     return float(acc[0]), float(acc[1]), float(acc[2])
 
 

@@ -209,7 +209,8 @@ def force_element_blame(model, q, u, t):
         N[:] = 0.0
         kf.force_elements(model._force_int[k:k + 1], model._force_data, model._parent,
                           model._axis, model._com, model._qfull, model._ufull, model._R,
-                          model._r, model._w, model._v, F, N, np.zeros(2), model._scratch)
+                          model._r, model._w, model._v, F, N, np.zeros(2), model._scratch,
+                          model._force_shapes)
         size = max(np.abs(F).max(initial=0.0), np.abs(N).max(initial=0.0))
         if not np.isfinite(size) or size > HUGE_FORCE:
             return (f"force element {el.name!r} ({el.kind}) gives a force of {size:.3g} at "

@@ -21,8 +21,10 @@ import warnings
 from . import SUMMARIES
 
 FIXED = ("semi-implicit-euler", "euler", "rk4", "implicit-midpoint")
-#: the model files of each layout, without and with force elements (``warmup_models``)
-LAYOUTS = (("pendulum", "forces"), ("chain", "chain_forces"), ("four_bar", "four_bar_forces"))
+#: the model files of each layout, without and with force elements (the small tree also
+#: with every kind, contacts between shapes among them: ``warmup_models``)
+LAYOUTS = (("pendulum", "forces", "pendulum_forces"), ("chain", "chain_forces"),
+           ("four_bar", "four_bar_forces"))
 
 
 def _runs(models, integrators):
@@ -41,16 +43,16 @@ ROUTES = (
     ("articulated", "6 or more speeds: the articulated-body route, a spherical joint "
      "(DOP853, semi-implicit Euler, RK4)", True,
      _runs(["chain"], ["DOP853", "semi-implicit-euler", "rk4"])),
-    ("force elements", "springs, dampers, tables, bushing, bearing, contact, a stop, a "
-     "compiled law, a PD actuator, a drive; on "
-     "both routes (DOP853, semi-implicit Euler, RK4)", True,
-     _runs(["forces"], ["DOP853", "semi-implicit-euler", "rk4"])
+    ("force elements", "springs, dampers, tables, bushing, bearing, contact, contacts "
+     "between shapes, a stop, a compiled law, a PD actuator, a drive; a spring alone "
+     "(no shape-contact kernel); on both routes (DOP853, semi-implicit Euler, RK4)", True,
+     _runs(["forces", "pendulum_forces"], ["DOP853", "semi-implicit-euler", "rk4"])
      + _runs(["chain_forces"], ["DOP853", "semi-implicit-euler"])),
     ("closed loop", "a four-bar: constrained accelerations, projection, the loop's "
      "reactions; with a force element (DOP853, RK4)", True,
      _runs(["four_bar", "four_bar_forces"], ["DOP853", "rk4"])),
     ("fixed-step, all", "every fixed-step scheme on every layout", False,
-     _runs([m for pair in LAYOUTS for m in pair], FIXED)),
+     _runs([m for group in LAYOUTS for m in group], FIXED)),
     ("scipy integrators", "Radau, BDF, LSODA: the packed right-hand side", False,
      _runs(["pendulum"], ["Radau", "BDF", "LSODA"])
      + _runs(["forces", "chain", "chain_forces"], ["Radau"])),

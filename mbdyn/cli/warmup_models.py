@@ -2,10 +2,12 @@
 exercises one route of the compiled kernels, as a user's model file of that kind would.
 The kernels are compiled for argument *types*, not sizes or values: the workspace's
 layout (a tree below 6 speeds, ``M u' = f``; 6 or more, the articulated bodies; a closed
-loop) and whether there are force elements (their tables are arrays, or ``None``).  So a
-two-link pendulum compiles what every small tree needs, a six-link chain what every
-articulated-body run needs, each of them with one force element what every such model
-with force elements needs; events, drives and outputs do not change the types."""
+loop), whether there are force elements (their tables are arrays, or ``None``) and
+whether some are contacts between shapes.  So a two-link pendulum compiles what every
+small tree needs, a six-link chain what every articulated-body run needs, each of them
+with one force element what every such model with force elements needs, the model of every
+kind of force element what one with contacts between shapes needs; events, drives and
+outputs do not change the types."""
 
 #: two links with inertia (2 speeds: ``M u' = f``), every output
 PENDULUM = """
@@ -86,7 +88,8 @@ reactions = true
 energy = true
 """
 
-#: every kind of force element, tables, a drive, a compiled law and an actuator reading
+#: every kind of force element (contacts between shapes too), tables, a drive, a compiled
+#: law and an actuator reading
 #: the clock (a block on springs, a rotor on a bearing, a ball on the floor)
 FORCES = """
 [model]
@@ -217,6 +220,25 @@ kp = 10
 kd = 1
 setpoint = "0.01*sin(t)"
 
+[[shapes]]
+name = "ball_shape"
+kind = "sphere"
+body = "ball"
+radius = 0.02
+
+[[shapes]]
+name = "ground_plane"
+kind = "plane"
+body = "ground"
+normal = [0, 0, 1]
+
+[[contacts]]
+name = "touch"
+pairs = [["ground_plane", "ball_shape"]]
+stiffness = 1e5
+restitution = 0.8
+impact_speed = 1.0
+
 [simulation]
 t_end = 0.02
 dt = 0.0005
@@ -317,5 +339,6 @@ damping = 0.01
 #: ``{file stem: text}`` of the models above, and of the chain and the four-bar with a
 #: force element
 MODELS = {"pendulum": PENDULUM, "chain": CHAIN, "forces": FORCES, "four_bar": FOUR_BAR,
+          "pendulum_forces": _with_spring(PENDULUM, "theta1"),
           "chain_forces": _with_spring(CHAIN, "j0"),
           "four_bar_forces": _with_spring(FOUR_BAR, "rocker")}

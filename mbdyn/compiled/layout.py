@@ -17,6 +17,7 @@ from ..kernels import evaluate as ke
 from ..kernels import joints as kj
 from ..kernels import packed as kp
 from ..kernels.constraints import constraint_count
+from ..kernels.contact import CONTACT_SHAPES
 from ..elements.joints import make_drive
 from ..elements.values import t as TIME
 from .constraint_packing import pack_constraints
@@ -256,9 +257,13 @@ def pack(model):
         {k: getattr(model, attr[k]) for k in kp.FAR})
     for name, view in views.items():
         setattr(model, attr[name], view)
-    # the force table, or None without force elements: the kernels are then compiled
-    # without the force kernel (kernels.packed)
-    forces = model._force_int if model._force_int.shape[0] else None
+    # the force elements as the kernels take them (kernels.packed): None without any, so
+    # that the kernels are compiled without the force kernel; else the table and None or
+    # True for its contacts between shapes (without, no shape-contact kernel)
+    model._force_shapes = (True if (model._force_int[:, 0] == CONTACT_SHAPES).any()
+                           else None)
+    forces = ((model._force_int, model._force_shapes) if model._force_int.shape[0]
+              else None)
     model._packed = (fbuf, ibuf, table, forces)
 
 

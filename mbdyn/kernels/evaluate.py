@@ -31,18 +31,23 @@ def scratch_size(n, nu, nuf):
 def kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                          mass, com, gravity, qfull, ufull, udfull,
                          load_body, load_point, load_force, load_moment, load_in_body,
-                         force_int, force_data, switches,
+                         forces, force_data, switches,
                          R, r, w, v, alpha, a, JR, JT, S, F, N, scratch):
     """Motion of every frame, then the applied loads ``F``, ``N``: gravity, point loads
-    and force elements.  ``force_int`` is None for a model without force elements: a type,
-    not a count, so that numba prunes the call and compiles no force kernel for it."""
+    and force elements.  ``forces`` is None for a model without force elements, else the
+    force table and whether it has contacts between shapes (``(force_int, shapes)``,
+    ``shapes`` None or True): types, not counts, so that numba prunes the calls and
+    compiles for such a model no force kernel, or no shape-contact kernel
+    (``forces.force_elements``)."""
     walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull, ufull,
          udfull, R, r, w, v, alpha, a, JR, JT, S, scratch)
     applied_loads(mass, com, gravity, R, r, load_body, load_point, load_force, load_moment,
                   load_in_body, F, N, scratch)
-    if force_int is not None and force_int.shape[0]:
-        force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F,
-                       N, force_data[0:0], scratch)
+    if forces is not None:
+        force_int, shapes = forces
+        if force_int.shape[0]:
+            force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w,
+                           v, F, N, force_data[0:0], scratch, shapes)
 
 
 @njit(**UNCOUNTED)
@@ -81,14 +86,14 @@ def jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch):
     parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx = tree
     mass, com, inertia, has_inertia, gravity = body
     qfull, ufull, udfull = state
-    (load_body, load_point, load_force, load_moment, load_in_body, force_int, force_data,
+    (load_body, load_point, load_force, load_moment, load_in_body, forces, force_data,
      switches) = loads
     R, r, w, v, alpha, a, JR, JT, S, F, N = motion
     M, f, L, ud = jourdain
     kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                          mass, com, gravity, qfull, ufull, udfull,
                          load_body, load_point, load_force, load_moment, load_in_body,
-                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, S, F,
+                         forces, force_data, switches, R, r, w, v, alpha, a, JR, JT, S, F,
                          N, scratch)
     if switches[0] == 0:
         drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr,
@@ -109,7 +114,7 @@ def jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch):
 def newton_euler_solution(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                           mass, com, inertia, gravity, qfull, ufull, udfull,
                           load_body, load_point, load_force, load_moment, load_in_body,
-                          force_int, force_data, switches,
+                          forces, force_data, switches,
                           react_joint, react_force, react_moment,
                           R, r, w, v, alpha, a, JR, JT, S, F, N, A, b, scratch):
     """Kinematics, loads, the Newton-Euler system with reactions, solved by LU.
@@ -119,7 +124,7 @@ def newton_euler_solution(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc
     kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                          mass, com, gravity, qfull, ufull, udfull,
                          load_body, load_point, load_force, load_moment, load_in_body,
-                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, S, F,
+                         forces, force_data, switches, R, r, w, v, alpha, a, JR, JT, S, F,
                          N, scratch)
     if switches[0] == 0:
         drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr,
@@ -145,14 +150,14 @@ def articulated_accelerations(tree, body, state, loads, motion, work, ud, scratc
     parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx = tree
     mass, com, inertia, gravity = body
     qfull, ufull, udfull = state
-    (load_body, load_point, load_force, load_moment, load_in_body, force_int, force_data,
+    (load_body, load_point, load_force, load_moment, load_in_body, forces, force_data,
      switches) = loads
     R, r, w, v, alpha, a, JR, JT, S, F, N = motion
     IA, pA, cb, U, Dl, acc = work
     kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                          mass, com, gravity, qfull, ufull, udfull,
                          load_body, load_point, load_force, load_moment, load_in_body,
-                         force_int, force_data, switches, R, r, w, v, alpha, a, JR, JT, S, F,
+                         forces, force_data, switches, R, r, w, v, alpha, a, JR, JT, S, F,
                          N, scratch)
     if switches[0] == 0:
         drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr,
@@ -172,7 +177,7 @@ def articulated_accelerations(tree, body, state, loads, motion, work, ud, scratc
 def newton_euler_tree(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                       mass, com, inertia, gravity, qfull, ufull, udfull,
                       load_body, load_point, load_force, load_moment, load_in_body,
-                      force_int, force_data, switches, react_joint, react_force, react_moment,
+                      forces, force_data, switches, react_joint, react_force, react_moment,
                       R, r, w, v, alpha, a, JR, JT, S, F, N, IA, pA, cb, U, Dl, acc, wrench, ud,
                       lam, scratch):
     """The Newton-Euler equations with reaction unknowns solved in tree order: speed rates
@@ -181,7 +186,7 @@ def newton_euler_tree(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr
     pivot = articulated_accelerations(
         (parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx),
         (mass, com, inertia, gravity), (qfull, ufull, udfull),
-        (load_body, load_point, load_force, load_moment, load_in_body, force_int, force_data,
+        (load_body, load_point, load_force, load_moment, load_in_body, forces, force_data,
          switches), (R, r, w, v, alpha, a, JR, JT, S, F, N), (IA, pA, cb, U, Dl, acc), ud,
         scratch)
     if pivot != -1:

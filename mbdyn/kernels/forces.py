@@ -115,10 +115,13 @@ def _law(data, spring_off, spring_mode, damper_off, damper_mode, k, c, F0, x, xd
 
 @njit(**UNCOUNTED)
 def force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F, N,
-                   acc, work):
+                   acc, work, shapes):
     """Add every force element's wrenches to ``F``, ``N``; with ``acc.shape[0] >= 2`` also
     their potential energy (``acc[0]``) and non-conservative power (``acc[1]``).
-    ``work``: at least ``FORCE_WORK`` floats of scratch."""
+    ``work``: at least ``FORCE_WORK`` floats of scratch.  ``shapes``: None when the table
+    has no contact between shapes (``CONTACT_SHAPES``), else True -- a type, so that for
+    such a table numba compiles no shape-contact kernel (``kernels.contact``: a third of
+    the force kernel, 6 s of a first run)."""
     # long: one branch per force-element kind in one compiled loop: a kernel per kind would be
     # one more compiled entry point per kind and a dispatch per element.
     want = acc.shape[0] >= 2
@@ -249,7 +252,9 @@ def force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r,
                     P += f[q] * (va[q] - vb[q])
                 acc[1] += P
         elif kind == CONTACT_SHAPES:       # between shapes: kernels/contact.py
-            shape_contacts(off, force_data, R, r, w, v, com, F, N, acc, want, work[FORCE_WORK:])
+            if shapes is not None:
+                shape_contacts(off, force_data, R, r, w, v, com, F, N, acc, want,
+                               work[FORCE_WORK:])
         else:
             _contact(kind, ia, off, force_data, R, r, w, v, com, F, N, acc, want,
                      pa, va, d, f, lever, t, e1, zero)

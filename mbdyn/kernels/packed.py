@@ -12,10 +12,11 @@ The Jourdain entry points also scatter the free coordinates and speeds into the 
 state (what ``Model._fill`` does in Python for the other evaluations); drives and loads
 given as Python functions are still written by the caller first.
 
-Every packed kernel takes, after the offset table, the model's force-element table
-``forces`` (``force_int``, a view of the integer buffer) or ``None`` for a model without
-force elements: a type, not a count, so that the kernels are compiled for such a model
-without the force kernel (``evaluate.kinematics_and_loads``), as the compiled loops are.
+Every packed kernel takes, after the offset table, the model's force elements ``forces``:
+``None`` for a model without any, else ``(force_int, shapes)`` (the force table, a view of
+the integer buffer, and None or True for its contacts between shapes): types, not counts,
+so that the kernels are compiled for such a model without the force kernel or the
+shape-contact kernel (``evaluate.kinematics_and_loads``), as the compiled loops are.
 ``Model._packed`` holds the four, so that a call reads ``kernel(*model._packed, q, u)``.
 
 The arrays only the Jourdain and dense Newton-Euler routes read, O(n nu) and O(nu^2),
@@ -124,9 +125,10 @@ def place(table, far):
 
 @njit(inline="always", **UNCOUNTED)
 def force_table(ib, t):
-    """The force-element table ``force_int`` as a view of the integer buffer (for a caller
-    that has only the buffers, e.g. ``compiled.lowlevel``)."""
-    return c_view(ib, t[FORCE_INT], (t[9], ROW))
+    """The ``forces`` argument of a model with force elements of any kind, the table a view
+    of the integer buffer (for a caller that has only the buffers, e.g.
+    ``compiled.lowlevel``)."""
+    return c_view(ib, t[FORCE_INT], (t[9], ROW)), True
 
 
 @njit(inline="always", **UNCOUNTED)
@@ -139,7 +141,8 @@ def _views(fb, ib, t, forces):
     ``articulated.articulated_body`` and the joint wrenches and reaction components), and
     the evaluations' scratch.  Offsets and addresses are read from ``t`` at run time:
     literal constants as arguments would make numba compile a slicing helper per
-    constant.  ``forces`` is the loads' force table as given (an array, or ``None``)."""
+    constant.  ``forces`` is the loads' force elements as given (see the module's
+    docstring)."""
     n, nu, nl, nqf, nuf, nanc, nreact = t[0], t[1], t[2], t[3], t[4], t[5], t[6]
     nj, nm = t[NJ], t[NM]
     fb, ib = untracked(fb), untracked(ib)       # slices of them are untracked too

@@ -82,7 +82,9 @@ def add_stops(b, stops):
     at the zero configuration."""
     model = b.system.compile(check_inertia=False)
     q = model.default_coordinates()
-    M = model.mass_matrix(q)
+    # by the kernels a run compiles anyway (the kinematics, Jourdain's terms), not the
+    # packed entry point of Model.mass_matrix: the same numbers, no compile of its own
+    M = model._mass_matrix(q, 0.0, model._jourdain_terms)
     for joint, c, lower, upper in stops:
         speed = b.system.joints[joint.name].speeds[0]
         m = float(M[model.speeds.index(speed), model.speeds.index(speed)])
