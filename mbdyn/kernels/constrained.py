@@ -141,11 +141,9 @@ def constraint_state(tree, state, motion, con, scratch):
                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma)
 
 
-@njit(cache=True, _nrt=True)
+@njit(cache=True)
 def constrained_call(tree, body, state, loads, motion, jourdain, con, scratch):
-    """``constrained_accelerations`` as a compiled entry point for Python (the compiled
-    loops inline it: ``routes.accelerations``); counted, explicitly, as
-    ``project_state_call``."""
+    """``constrained_accelerations`` as a compiled entry point for Python."""
     return constrained_accelerations(tree, body, state, loads, motion, jourdain, con,
                                      scratch)
 

@@ -50,12 +50,14 @@ def kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_
                            v, F, N, force_data[0:0], scratch, shapes)
 
 
-@njit(**UNCOUNTED)
+@njit(inline="always", **UNCOUNTED)
 def drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                            qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S, scratch):
     """The ``gyroscopic`` effect switched off: the motion again with every speed zero, so
     that the bias accelerations keep only the prescribed (drive) accelerations and
-    ``w x I w`` vanishes; the applied loads computed before keep the true velocities."""
+    ``w x I w`` vanishes; the applied loads computed before keep the true velocities.
+    Inlined into the evaluations (a compiled function of its own would be machine-coded
+    again, with the kinematics it calls, in every caller); Python calls it too."""
     nuf = ufull.shape[0]
     saved = c_view(scratch, KINEMATICS_WORK, (nuf,))
     for k in range(nuf):
