@@ -14,6 +14,7 @@ import numpy as np
 from ..errors import ModelError, SimulationError
 from ..kernels import constrained as kc
 from ..kernels.loop_solve import RANK_TOLERANCE
+from .inputs import plain
 
 
 def groups(model):
@@ -72,14 +73,23 @@ def mobility(model, q, t=0.0):
 
 def constrained_accelerations(model, q, u, t=0.0):
     """``u'`` of the closed mechanism, ``M u' = f + G^T lam``, ``G u' = gamma``; the
-    multipliers stay in the workspace (``multipliers``)."""
-    q, u = model._fill(q, u, t)
-    tree, body, state, loads, motion, jourdain = groups(model)
-    try:
-        status = kc.constrained_call(tree, body, state, loads, motion, jourdain, model._con,
-                                     model._scratch)
-    except ZeroDivisionError:
-        raise model._division_by_zero(q, t) from None
+    minimum-norm multipliers stay in the workspace (``multipliers``).  One compiled call
+    on the packed arrays: float64 arrays as they come, anything else converted and
+    checked first."""
+    kernel = kc.constrained_accelerations_packed
+    status = None
+    if not model._python_inputs and plain(q, model.nq) and plain(u, model.nu):
+        try:
+            status = kernel(*model._packed, *model._con_packed, q, u)
+        except ZeroDivisionError:
+            pass
+    if status is None:                           # convert, check, say what is wrong
+        q, u = model._fill(q, u, t)
+        q, u = np.require(q, float, "CW"), np.require(u, float, "CW")  # one compiled type
+        try:
+            status = kernel(*model._packed, *model._con_packed, q, u)
+        except ZeroDivisionError:
+            raise model._division_by_zero(q, t) from None
     if status >= 0:
         model._raise_singular(q, t, status)
     if status == -2:

@@ -15,8 +15,9 @@ import numpy as np
 
 from ..kernels import evaluate as ke
 from ..kernels import joints as kj
+from ..kernels import constrained as kc
 from ..kernels import packed as kp
-from ..kernels.constraints import constraint_count
+from ..kernels.constraints import DATA, constraint_count
 from ..kernels.contact import CONTACT_SHAPES
 from ..elements.joints import make_drive
 from ..elements.values import t as TIME
@@ -205,7 +206,7 @@ def loads(model, records):
     return functions
 
 
-def workspace(model, joints):
+def workspace(model, joints, loop_joints=0):
     """The arrays every evaluation writes into: joint-space state, frame motion, the
     joints' motion subspaces, applied loads, ``f``, the articulated inertias, the reaction
     unknowns, and one scratch array for the kernels' temporaries
@@ -213,7 +214,9 @@ def workspace(model, joints):
     its factor are empty here, allocated with the ancestor lists on the first use of a
     route that reads them (``full_workspace``), and the dense Newton-Euler system
     (6n x 6n) on the first use of its route (``Model._dense_system``): a 5,000-body model
-    would otherwise hold 7 GB for it, a 10,000-body chain 6.4 GB for the others."""
+    would otherwise hold 7 GB for it, a 10,000-body chain 6.4 GB for the others.
+    ``loop_joints``: how many loop joints close the tree (their constraint rows and
+    solves take the scratch after the tree's kernels, ``kernels.constrained.loop_work``)."""
     n, nu = model.n_frames, model.nu
     model._qfull = np.zeros(model._nq_full)
     model._ufull = np.zeros(model._nu_full)
@@ -239,8 +242,11 @@ def workspace(model, joints):
     model._pA, model._cb, model._acc = np.zeros((n, 6)), np.zeros((n, 6)), np.zeros((n, 6))
     model._Dl, model._W = np.zeros((n, 6, 7)), np.zeros((n, 6))
     model._lam = np.zeros(len(model._react_joint))
+    # contacts' broad phase; a closed mechanism's rows and solves (at most 6 rows a loop
+    # joint: a fixed joint's)
     model._scratch = np.zeros(max(ke.scratch_size(n, nu, model._nu_full),
-                                  getattr(model, "_force_work", 0)))   # contacts' broad phase
+                                  getattr(model, "_force_work", 0),
+                                  kc.loop_work(nu, 6 * loop_joints) if loop_joints else 0))
     model._slots = np.array(model._free_joint_slots, np.int64).reshape(-1, 5)
 
 
@@ -317,8 +323,21 @@ def constraints(model, loop_joints):
     full_workspace(model)          # the constraints' Jacobian reads the full JR, JT
     con_int, con_data, labels, owners, prim_owner = pack_constraints(model, loop_joints)
     m = constraint_count(con_int)
+    if model._scratch.size < kc.loop_work(model.nu, m):
+        raise RuntimeError(f"model {model.name!r}: the scratch holds {model._scratch.size} "
+                           f"floats, the loops need {kc.loop_work(model.nu, m)}")
     model.constraint_rows = labels
     model._row_joint, model._prim_joint = owners, prim_owner
-    model._con = (con_int, con_data, np.zeros(m), np.zeros(m), np.zeros((m, model.nu)),
-                  np.zeros(m), np.zeros(m),
-                  np.concatenate([[0.0, 1.0, -1.0, np.inf, 1.0, -1.0], np.zeros(m)]))
+    con_int = np.ascontiguousarray(con_int, np.int64)
+    # the float arrays are views of one buffer, in the order of kernels.constrained's
+    # con_views, so that the packed entry point (constrained_accelerations_packed) takes
+    # two arrays, not eight
+    nprim, nu = con_int.shape[0], model.nu
+    cf = np.zeros(kc.con_floats(nprim, m, nu))
+    ends = np.cumsum([0, nprim * DATA, m, m, m * nu, m, m, m + 6])
+    views = [cf[a:b] for a, b in zip(ends[:-1], ends[1:])]
+    views[0], views[3] = views[0].reshape(nprim, DATA), views[3].reshape(m, nu)
+    views[0][...] = con_data
+    views[6][:6] = [0.0, 1.0, -1.0, np.inf, 1.0, -1.0]
+    model._con = (con_int, *views)
+    model._con_packed = (con_int, cf)

@@ -67,7 +67,7 @@ class Model:
         self.gyroscopic = bool(self.effects.get("gyroscopic", True))
         self._force_int, self._force_data, laws = pack_forces(self, forces)
         self._switches = np.array([1 if self.gyroscopic else 0], np.int64)
-        layout.workspace(self, joints)
+        layout.workspace(self, joints, len(loop_joints))
         #: the Jourdain route's packed kernels (forward dynamics, state derivative): set
         #: with the arrays they read, on first use (layout.full_workspace)
         self._jourdain_kernel = self._jourdain_rates = None

@@ -9,23 +9,25 @@ They are solved by the range-space (Schur complement) method: with ``M = L L^T``
     ``u' = u0 + M^-1 G^T lam``.
 
 ``S`` is singular when constraints are redundant (a planar loop closed by a spatial
-revolute: five equations of rank two).  ``Y``'s singular value decomposition gives the
-rank -- singular values above ``loop_solve.RANK_TOLERANCE`` times the largest count -- and
-the minimum-norm ``lam`` over the rest: ``u'`` is unique whenever the motion is, ``lam``
-is the smallest multiplier vector that produces it.  The SVD is of ``Y`` (not of ``S``,
-whose singular values are squared) so that the rank decision keeps the digits; runs,
-whose rank is known, solve on rows instead (``loop_solve``).  When ``M`` is singular (a
-massless link whose motion the constraints fix) the augmented system ``[[M, G^T], [G,
+revolute: five equations of rank two).  A rank-revealing (column-pivoted) QR of ``Y``
+(``rank_qr``) gives the rank -- pivots above ``loop_solve.RANK_TOLERANCE`` times the first
+count -- and the minimum-norm ``lam`` over the rest: ``u'`` is unique whenever the motion
+is, ``lam`` is the smallest multiplier vector that produces it.  The QR is of ``Y`` (not
+of ``S``, whose singular values are squared) so that the rank decision keeps the digits;
+runs, whose rank is known, solve on rows instead (``loop_solve``).  When ``M`` is singular
+(a massless link whose motion the constraints fix) the augmented system ``[[M, G^T], [G,
 0]]`` is solved by least squares instead.
 """
 import numpy as np
 from numba import njit
 
-from .constraints import constraint_rows
+from .constraints import DATA, POINT, ROW_WORK, _constraint_rows, constraint_rows
 from .evaluate import jourdain_accelerations
 from .joints import coordinate_rates
 from .kinematics import walk
-from .loop_solve import augmented_solve, constrained_solve, min_norm_step, rank_of
+from .loop_solve import augmented_solve, constrained_solve, min_norm_step, rank_of, solve_work
+from .packed import _scatter, _views
+from .views import UNCOUNTED, c_view, untracked
 
 #: the projection stops when every position residual is below this (metres for points,
 #: dimensionless for directions)
@@ -45,15 +47,16 @@ def constrained_accelerations(tree, body, state, loads, motion, jourdain, con, s
     qfull, ufull, udfull = state
     con_int, con_data, phi, psi, G, gamma, lam, info = con
     pivot = jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch)
-    constraint_rows(con_int, con_data, tree[8], tree[6], tree[7], qfull, ufull, udfull,
-                    R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma)
+    # the scratch is free once M and f are made (loop_work: sized for the rows and solves)
+    _constraint_rows(con_int, con_data, tree[8], tree[6], tree[7], qfull, ufull, udfull,
+                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch)
     if pivot >= 0:
         for k in range(ud.shape[0]):
             ud[k] = f[k]
         if not augmented_solve(M, f, G, gamma, ud, lam, info):
             return pivot
     elif pivot == -1:
-        constrained_solve(M, L, ud, G, gamma, lam, info)
+        constrained_solve(M, L, ud, G, gamma, lam, info, scratch)
     for k in range(ud.shape[0]):
         if not np.isfinite(ud[k]):
             return -2
@@ -90,8 +93,8 @@ def project_state(y, nq, slots, quats, free_q, free_u, tree, state, motion, con,
             ufull[free_u[k]] = y[nq + k]
         walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull,
              ufull, udfull, R, r, w, v, alpha, a, JR, JT, S, scratch)
-        constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
-                        R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma)
+        _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
+                         R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch)
         if residual_norm(phi) <= PROJECTION_TOLERANCE:
             break
         if steps == PROJECTION_ITERATIONS:
@@ -141,9 +144,40 @@ def constraint_state(tree, state, motion, con, scratch):
                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma)
 
 
-@njit(cache=True)
-def constrained_call(tree, body, state, loads, motion, jourdain, con, scratch):
-    """``constrained_accelerations`` as a compiled entry point for Python."""
-    return constrained_accelerations(tree, body, state, loads, motion, jourdain, con,
-                                     scratch)
+def loop_work(nu, m):
+    """Floats of the model's scratch a closed mechanism's evaluation and projection take
+    after the tree's kernels (at most ``m`` constraint rows, ``nu`` free speeds)."""
+    return max(ROW_WORK + m * nu, solve_work(nu, m))
 
+
+def con_floats(nprim, m, nu):
+    """Floats of the constraints' buffer (``con_views``)."""
+    return nprim * DATA + 4 * m + m * nu + 6 + m
+
+
+@njit(inline="always", **UNCOUNTED)
+def con_views(con_int, cf, nu):
+    """The constraints' workspace ``(con_int, con_data, phi, psi, G, gamma, lam, info)``
+    with its float arrays as views of the one buffer ``cf``, in that order."""
+    nprim = con_int.shape[0]
+    m = 0
+    for k in range(nprim):
+        m += 3 if con_int[k, 0] == POINT else 1
+    cf = untracked(cf)
+    at = nprim * DATA
+    return (con_int, c_view(cf, 0, (nprim, DATA)), cf[at:at + m], cf[at + m:at + 2 * m],
+            c_view(cf, at + 2 * m, (m, nu)), cf[at + 2 * m + m * nu:at + 3 * m + m * nu],
+            cf[at + 3 * m + m * nu:at + 4 * m + m * nu],
+            cf[at + 4 * m + m * nu:at + 5 * m + m * nu + 6])
+
+
+@njit(**UNCOUNTED)
+def constrained_accelerations_packed(fb, ib, t, forces, con_int, cf, q, u):
+    """Scatter ``q``, ``u``, then ``constrained_accelerations`` on the packed arrays
+    (``kernels.packed``) and the constraints' buffer (``con_views``): the Python entry
+    point of a closed mechanism's forward dynamics and multipliers (same return value;
+    ``u'`` in the ``ud`` view, ``lam`` in the constraints' workspace)."""
+    _scatter(fb, ib, t, q, u)
+    tree, body, state, loads, _, motion, jourdain, _, scratch = _views(fb, ib, t, forces)
+    return constrained_accelerations(tree, body, state, loads, motion, jourdain,
+                                     con_views(con_int, cf, t[1]), scratch)

@@ -89,6 +89,25 @@ def _add_point_row(G, Gabs, row, i, rho, e, sign, JT, JR):
 
 
 @njit(cache=True, inline="always")
+def _add_point_rows(G, Gabs, row, i, rho, sign, JT, JR):
+    """``G[row:row + 3] += sign * J_P``: ``_add_point_row`` for the three world axes at
+    once (the point's Jacobian column computed once, not once per axis)."""
+    if i < 0:
+        return
+    for col in range(G.shape[1]):
+        jr0, jr1, jr2 = JR[i, 0, col], JR[i, 1, col], JR[i, 2, col]
+        j0 = JT[i, 0, col] + jr1 * rho[2] - jr2 * rho[1]
+        j1 = JT[i, 1, col] + jr2 * rho[0] - jr0 * rho[2]
+        j2 = JT[i, 2, col] + jr0 * rho[1] - jr1 * rho[0]
+        G[row, col] += sign * j0
+        G[row + 1, col] += sign * j1
+        G[row + 2, col] += sign * j2
+        Gabs[row, col] += abs(j0)
+        Gabs[row + 1, col] += abs(j1)
+        Gabs[row + 2, col] += abs(j2)
+
+
+@njit(cache=True, inline="always")
 def _add_rotation_row(G, Gabs, row, i, e, sign, JR):
     """``G[row] += sign * e^T JR_i``."""
     if i < 0:
@@ -213,10 +232,8 @@ def _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
                 phi[row + k] = d[k]
                 psi[row + k] = dv[k]
                 gamma[row + k] = -(ac[k] - ap[k])
-                for j in range(3):
-                    t1[j] = 1.0 if j == k else 0.0
-                _add_point_row(G, Gabs, row + k, ic, rc, t1, 1.0, JT, JR)
-                _add_point_row(G, Gabs, row + k, ip, rp, t1, -1.0, JT, JR)
+            _add_point_rows(G, Gabs, row, ic, rc, 1.0, JT, JR)
+            _add_point_rows(G, Gabs, row, ip, rp, -1.0, JT, JR)
             row += 3
         elif kind == SLIDE:
             _vector(ip, A, R, va)                          # n, fixed in p

@@ -1,8 +1,8 @@
 """Rank-tolerant solves of the constrained equations ``M u' = f + G^T lam``, ``G u' = gamma``
 (``kernels.constrained``) and of the projection's minimum-norm steps.
 
-Outside runs the rank is decided by the singular value decomposition of ``Y = L^-1 G^T``
-(``constrained_solve``) and the multipliers are the minimum-norm ones.  A run knows its
+Outside runs the rank is decided by a rank-revealing (column-pivoted) QR of ``Y = L^-1 G^T``
+(``constrained_solve``, ``kernels.rank_qr``) and the multipliers are the minimum-norm ones.  A run knows its
 rank (decided at every projected step) and solves on rows: the complement ``S = Y^T Y``
 factored by Cholesky with complete pivoting stopped at that rank (``_pivoted_solve``), or,
 cheaper, on the rows the last projection chose (``_chosen_rows_solve``); ``u'`` is the
@@ -12,10 +12,12 @@ semi-definite takes the augmented system by least squares (``augmented_solve``).
 import numpy as np
 from numba import njit
 
+from .rank_qr import qr_solve, work_size
 from .views import UNCOUNTED, c_view
 
-#: singular values of ``Y = L^-1 G^T`` below this fraction of the largest are taken as
-#: zero (redundant constraints, or a singular configuration)
+#: pivots of the column-pivoted QR of ``Y = L^-1 G^T`` (which follow its singular values)
+#: below this fraction of the first are taken as zero (redundant constraints, or a
+#: singular configuration)
 RANK_TOLERANCE = 1e-9
 #: during a run, a singular value of ``Y`` below this fraction of the largest is dropped
 #: although the mechanism's rank counts it: the configuration is (nearly) singular, where
@@ -29,53 +31,29 @@ PASSAGE_TOLERANCE = 1e-6
 ROWS = 5
 
 
-@njit(cache=True, _nrt=True)   # allocates: counted even under an uncounted caller
-def constrained_solve(M, L, ud, G, gamma, lam, info):
+def solve_work(nu, m):
+    """Floats of scratch ``constrained_solve`` takes (``m`` rows, ``nu`` free speeds)."""
+    return max(work_size(nu, m), nu * m + m * m + 4 * m + nu)
+
+
+@njit(**UNCOUNTED)
+def constrained_solve(M, L, ud, G, gamma, lam, info, work):
     """``ud`` (holding ``M^-1 f`` on entry, ``L`` the Cholesky factor of ``M``) corrected
     to the constrained accelerations; ``lam`` the minimum-norm multipliers.  ``info[0]``:
-    the rank of ``G``, ``info[1]``: the smallest singular value kept over the largest
-    (how far from a singular configuration)."""
-    m, nu = G.shape[0], G.shape[1]
+    the rank of ``G``, ``info[1]``: the last pivot kept over the first, which follows the
+    smallest singular value kept over the largest (how far from a singular configuration).
+    During a run (its rank known) the rows' solves below; else ``rank_qr.qr_solve``.
+    ``work``: ``solve_work`` floats of scratch (no allocation, no reference counting: an
+    evaluation's kernels pass the model's scratch, free once ``M`` and ``f`` are made)."""
+    m = G.shape[0]
     if m == 0:
         info[0], info[1] = 0.0, 1.0
         return
     keep = info[2]               # during a run: the rank at the last projected state
     if keep >= 0:
-        _pivoted_solve(L, ud, G, gamma, lam, info, int(keep),
-                       np.empty(nu * m + m * m + 4 * m + nu))
+        _pivoted_solve(L, ud, G, gamma, lam, info, int(keep), work)
         return
-    res = gamma.copy()
-    for i in range(m):
-        for k in range(nu):
-            res[i] -= G[i, k] * ud[k]
-    Y = np.empty((nu, m))
-    for j in range(m):                              # L Y = G^T, column by column
-        for i in range(nu):
-            s = G[j, i]
-            for k in range(i):
-                s -= L[i, k] * Y[k, j]
-            Y[i, j] = s / L[i, i]
-    U, sv, Vt = np.linalg.svd(Y, full_matrices=False)
-    top = sv[0] if sv.shape[0] else 0.0
-    rank = 0
-    smallest = 1.0
-    c = np.zeros(sv.shape[0])
-    for k in range(sv.shape[0]):
-        if sv[k] > RANK_TOLERANCE * top and top > 0.0:
-            rank += 1
-            smallest = sv[k] / top
-            acc = 0.0
-            for i in range(m):
-                acc += Vt[k, i] * res[i]
-            c[k] = acc / (sv[k] * sv[k])
-    for i in range(m):
-        acc = 0.0
-        for k in range(sv.shape[0]):
-            acc += Vt[k, i] * c[k]
-        lam[i] = acc
-    _add_correction(L, ud, Y, lam, np.empty(nu), m)
-    info[0] = rank
-    info[1] = smallest
+    qr_solve(L, ud, G, gamma, lam, info, RANK_TOLERANCE, work)
 
 
 @njit(cache=True, inline="always")

@@ -1,0 +1,176 @@
+"""The constrained accelerations and minimum-norm multipliers by a rank-revealing QR.
+
+With ``L`` the Cholesky factor of ``M`` and ``Y = L^-1 G^T`` (free speeds x rows), the
+equations ``M u' = f + G^T lam``, ``G u' = gamma`` become ``Y^T Y lam = res`` (``res =
+gamma - G M^-1 f``) and ``u' = M^-1 f + L^-T (Y lam)``.  Householder's QR with column
+pivoting, ``Y P = Q [[R11, R12], [0, 0]]``, stops where the next column's remaining norm
+falls below ``tolerance`` of the first (that is the rank ``r``: the pivoted diagonal follows
+the singular values, the first equal to the largest column norm).  Then
+
+* ``Y lam = Q1 w`` with ``R11^T w = (P^T res)[:r]``: the correction ``z = Y lam`` is unique
+  (it is ``u'`` that is unique), whatever the rows left out;
+* the minimum-norm multipliers solve ``[R11 R12] mu = w`` (``mu = P^T lam``): by a second
+  QR, of ``[R11 R12]^T``, when rows were left out (redundant constraints); ``R11^-1 w``
+  when none was.
+
+No LAPACK call, no allocation: a four-bar's five rows cost a fraction of an SVD, which
+allocated its three factors and its work arrays at every call.
+"""
+import numpy as np
+from numba import njit
+
+from .views import UNCOUNTED, c_view
+
+
+@njit(cache=True, inline="always")
+def work_size(nu, m):
+    """Floats of scratch ``qr_solve`` takes."""
+    return nu * m + m * m + 8 * m + 2 * nu
+
+
+@njit(cache=True, inline="always")
+def _reflect(A, k, rows, cols, col0):
+    """Householder reflector of ``A[k:rows, k]`` (kept there, the vector ``v``), applied to
+    ``A[k:rows, col0:cols]``; returns ``(R_kk, beta)`` with ``H = I - beta v v^T``."""
+    norm = 0.0
+    for i in range(k, rows):
+        norm += A[i, k] * A[i, k]
+    norm = np.sqrt(norm)
+    if norm == 0.0:
+        return 0.0, 0.0
+    alpha = -norm if A[k, k] >= 0.0 else norm
+    A[k, k] -= alpha
+    vv = 0.0
+    for i in range(k, rows):
+        vv += A[i, k] * A[i, k]
+    beta = 2.0 / vv
+    for j in range(col0, cols):
+        s = 0.0
+        for i in range(k, rows):
+            s += A[i, k] * A[i, j]
+        s *= beta
+        for i in range(k, rows):
+            A[i, j] -= s * A[i, k]
+    return alpha, beta
+
+
+@njit(cache=True, inline="always")
+def _apply_reflectors(A, beta, r, x, rows):
+    """``x = H_0 H_1 ... H_(r-1) x`` for the reflectors kept in ``A``'s columns."""
+    for k in range(r - 1, -1, -1):
+        if beta[k] == 0.0:
+            continue
+        s = 0.0
+        for i in range(k, rows):
+            s += A[i, k] * x[i]
+        s *= beta[k]
+        for i in range(k, rows):
+            x[i] -= s * A[i, k]
+
+
+@njit(cache=True, inline="always")
+def pivoted_qr(A, tolerance, perm, Rd, beta):
+    """Householder QR with column pivoting of ``A`` (rows x cols) in place: ``perm`` the
+    column order, ``Rd`` the diagonal of ``R``, ``R``'s strict upper part in ``A``, the
+    reflectors below it.  Stops at the first column whose remaining norm is at most
+    ``tolerance`` times the first column's; returns that rank and the first norm."""
+    rows, cols = A.shape[0], A.shape[1]
+    for j in range(cols):
+        perm[j] = j
+    first = 0.0
+    for k in range(min(rows, cols)):
+        best, at = -1.0, k
+        for j in range(k, cols):
+            s = 0.0
+            for i in range(k, rows):
+                s += A[i, j] * A[i, j]
+            if s > best:
+                best, at = s, j
+        if k == 0:
+            first = np.sqrt(best)
+        if not np.sqrt(best) > tolerance * first or first == 0.0:
+            return k, first
+        if at != k:
+            for i in range(rows):
+                A[i, k], A[i, at] = A[i, at], A[i, k]
+            perm[k], perm[at] = perm[at], perm[k]
+        Rd[k], beta[k] = _reflect(A, k, rows, cols, k + 1)
+    return min(rows, cols), first
+
+
+@njit(**UNCOUNTED)
+def qr_solve(L, ud, G, gamma, lam, info, tolerance, work):
+    """``ud`` (``M^-1 f`` on entry) corrected to the constrained ``u'``, ``lam`` the
+    minimum-norm multipliers, ``info[0]`` the rank, ``info[1]`` the last kept pivot over
+    the first (how far from a singular configuration).  ``work``: ``work_size`` floats."""
+    m, nu = G.shape[0], G.shape[1]
+    A, B = c_view(work, 0, (nu, m)), c_view(work, nu * m, (m, m))
+    at = nu * m + m * m
+    res, perm, Rd, beta = (c_view(work, at, (m,)), c_view(work, at + m, (m,)),
+                           c_view(work, at + 2 * m, (m,)), c_view(work, at + 3 * m, (m,)))
+    mu, Ud, beta2, w = (c_view(work, at + 4 * m, (m,)), c_view(work, at + 5 * m, (m,)),
+                        c_view(work, at + 6 * m, (m,)), c_view(work, at + 8 * m, (nu,)))
+    z = c_view(work, at + 8 * m + nu, (nu,))
+    for i in range(m):
+        s = gamma[i]
+        for k in range(nu):
+            s -= G[i, k] * ud[k]
+        res[i] = s
+        lam[i] = 0.0
+    for j in range(m):                              # L A = G^T, column by column
+        for i in range(nu):
+            s = G[j, i]
+            for k in range(i):
+                s -= L[i, k] * A[k, j]
+            A[i, j] = s / L[i, i]
+    r, first = pivoted_qr(A, tolerance, perm, Rd, beta)
+    info[0] = r
+    info[1] = abs(Rd[r - 1]) / first if r else 1.0
+    if r == 0:
+        return
+    for i in range(r):                              # R11^T w = (P^T res)[:r]
+        s = res[int(perm[i])]
+        for k in range(i):
+            s -= A[k, i] * w[k]
+        w[i] = s / Rd[i]
+    for i in range(r, nu):
+        w[i] = 0.0
+    for i in range(nu):
+        z[i] = w[i]
+    _apply_reflectors(A, beta, r, z, nu)            # z = Q1 w = Y lam
+    for i in range(nu - 1, -1, -1):                 # u' += L^-T z
+        s = z[i]
+        for k in range(i + 1, nu):
+            s -= L[k, i] * z[k]
+        z[i] = s / L[i, i]
+    for i in range(nu):
+        ud[i] += z[i]
+    _min_norm_multipliers(A, Rd, r, m, w, B, Ud, beta2, mu)
+    for i in range(m):
+        lam[int(perm[i])] = mu[i]
+
+
+@njit(cache=True, inline="always")
+def _min_norm_multipliers(A, Rd, r, m, w, B, Ud, beta2, mu):
+    """``mu``: the minimum-norm solution of ``[R11 R12] mu = w`` (``R`` as ``pivoted_qr``
+    left it); ``B`` (m x m), ``Ud``, ``beta2``: scratch."""
+    if r == m:                                      # R11 mu = w, back substitution
+        for i in range(r - 1, -1, -1):
+            s = w[i]
+            for k in range(i + 1, r):
+                s -= A[i, k] * mu[k]
+            mu[i] = s / Rd[i]
+        return
+    for j in range(m):                              # B = [R11 R12]^T (m x r)
+        for i in range(r):
+            B[j, i] = Rd[i] if j == i else (A[i, j] if j > i else 0.0)
+    for k in range(r):
+        Ud[k], beta2[k] = _reflect(B, k, m, r, k + 1)
+    for i in range(r):                              # U^T s = w, s into mu[:r]
+        s = w[i]
+        for k in range(i):
+            s -= B[k, i] * mu[k]
+        mu[i] = s / Ud[i]
+    for i in range(r, m):
+        mu[i] = 0.0
+    _apply_reflectors(B, beta2, r, mu, m)           # mu = Z [s; 0]
