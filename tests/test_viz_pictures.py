@@ -81,7 +81,7 @@ def test_springs_dampers_planes_and_actuators_are_drawn():
 def test_extra_primitives_hook_adds_solids(monkeypatch):
     from mbdyn.viz import drawing
     box = ("box", (np.eye(3), np.array([0.0, 0.0, -0.5])), (0.1, 0.2, 0.3))
-    monkeypatch.setattr(drawing, "extra_primitives", lambda model, kin: [box])
+    monkeypatch.setattr(drawing, "extra_primitives", lambda model, kin, q=None, scale=1.0: [box])
     res = _load("double_pendulum.toml").simulate(t_end=0.1)
     sc = frames(res, [0.0])[0]
     v = sc.solids[-1][0]

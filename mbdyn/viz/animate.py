@@ -141,7 +141,7 @@ def _figure(model, scenes, title, speed):
         ax.set_zlabel("z [m]")
         ax.tick_params(labelsize=7)
         pace = f"  ({speed:g}x)" if speed != 1 else ""
-        ax.set_title(f"{mathtext(title)}\nt = {sc.t:.3f} s{pace}", fontsize=9)
+        ax.set_title(f"{mathtext(title + sc.caption)}\nt = {sc.t:.3f} s{pace}", fontsize=9)
         return []
     return fig, draw
 

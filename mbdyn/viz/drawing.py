@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .contact_shapes import contact_primitives, ground_planes
+from .flexible_shapes import flexible_primitives
 from .meshes import frame_of, primitive_mesh
 
 AXES = ("#e41a1c", "#4daf4a", "#377eb8")
@@ -53,11 +54,13 @@ class Drawing:
     sizes: dict = field(default_factory=dict)
 
 
-def extra_primitives(model, kin):
+def extra_primitives(model, kin, q=None, scale=1.0):
     """Hook: extra solids of an instant as ``[(kind, (R, p), size)]`` (world pose; kinds
     and sizes as ``viz.meshes.PRIMITIVES``), the same kinds and sizes at every instant, in
-    the same order: the contact shapes (``viz.contact_shapes``)."""
-    return contact_primitives(model, kin)
+    the same order: the contact shapes (``viz.contact_shapes``) and the flexible bodies'
+    deformed shapes at the state ``q``, deflections drawn ``scale`` times
+    (``viz.flexible_shapes``)."""
+    return contact_primitives(model, kin) + flexible_primitives(model, kin, q, scale)
 
 
 def _at(model, frame, point):
@@ -141,9 +144,9 @@ def build(model, geometry, centre, half, primitives=()):
     _forces(model, d, centre, half)
     for name, point, normal in ground_planes(model):
         d.planes.append((name, *_plane(point, normal, centre, half)))
-    for k, (kind, _, size) in enumerate(primitives):
+    for k, (kind, _, size, *colour) in enumerate(primitives):
         d.solids.append((len(geometry) + k, *primitive_mesh(kind, (np.eye(3), np.zeros(3)),
-                                                            size), PRIMITIVE))
+                                                            size), *(colour or [PRIMITIVE])))
         d.primitives.append((kind, size))
     return d
 

@@ -18,6 +18,7 @@ import numpy as np
 from ..elements.bodies import shapes_of
 from ..errors import ModelError
 from . import drawing as dr
+from .flexible_shapes import caption, deflection_scale
 from .meshes import shape_mesh
 
 PALETTE = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
@@ -40,6 +41,7 @@ class Scene3D:
     tags: list = field(default_factory=list)
     planes: list = field(default_factory=list)
     extent: tuple = None
+    caption: str = ""
 
 
 def model_geometry(model):
@@ -53,13 +55,15 @@ def model_geometry(model):
     masses = np.array([b.mass for b in bodies])
     biggest = masses.max() if masses.size and masses.max() > 0 else 1.0
     out = []
+    flexible = set(getattr(model, "flexible_bodies", ()))
     for i, (b, j) in enumerate(zip(bodies, joints)):
         shapes = shapes_of(b)
         own = PALETTE[i % len(PALETTE)]
         colour = next((s["color"] for s in shapes if s.get("color")), None) or own
         size = 6 + 10 * np.cbrt(b.mass / biggest) if b.mass > 0 else 0
         meshes = [(*m, s.get("color") or own) for s in shapes
-                  for m in [shape_mesh(s)] if m is not None]
+                  for m in [shape_mesh(s)] if m is not None
+                  and b.name not in flexible]        # drawn deformed (viz.flexible_shapes)
         out.append({"name": b.name, "shape": b.shape, "color": colour, "size": float(size),
                     "com": np.asarray(b.com, float), "parent": int(model._parent[i]),
                     "mass": b.mass, "attached": j.kind != "free", "triad": triad,
@@ -75,7 +79,8 @@ class PosedRun:
     when asked, the contact forces as ``arrows``: per pose an array ``(k, 2, 3)`` of
     segments from each touching point along its force (``Model.contact_forces``); ``box``
     the corners ``(lo, hi)`` of the box the mechanism fills over the run (its pieces and
-    the output points; the ground planes left out)."""
+    the output points; the ground planes left out); ``deflection_scale``: the factor
+    the flexible bodies' deflections are drawn with (``viz.flexible_shapes``)."""
     model: object
     geometry: list
     drawing: dr.Drawing
@@ -85,10 +90,11 @@ class PosedRun:
     points: dict
     arrows: list = field(default_factory=list)
     box: tuple = None
+    deflection_scale: float = 1.0
 
 
-def _posed(model, kin):
-    prims = dr.extra_primitives(model, kin)
+def _posed(model, kin, q=None, scale=1.0):
+    prims = dr.extra_primitives(model, kin, q, scale)
     R = np.concatenate([kin.R, np.array([p[1][0] for p in prims]).reshape(-1, 3, 3)])
     r = np.concatenate([kin.r, np.array([p[1][1] for p in prims]).reshape(-1, 3)])
     return R, r, prims
@@ -121,9 +127,10 @@ def prepare(result, times, contact_forces=False):
     model = result.model
     geometry = model_geometry(model)
     poses, first, forces = [], None, []
-    for t in times:
-        q, u = state_at(result, t)
-        R, r, prims = _posed(model, model.kinematics(q, u, t=t))
+    states = [state_at(result, t) for t in times]
+    scale = deflection_scale(model, result.q)           # the whole run's: one per run
+    for t, (q, u) in zip(times, states):
+        R, r, prims = _posed(model, model.kinematics(q, u, t=t), q, scale)
         first = prims if first is None else first
         poses.append((float(t), R, r))
         if contact_forces:
@@ -137,7 +144,7 @@ def prepare(result, times, contact_forces=False):
         centre, half = _extent(d, [], np.vstack([extra, corners.mean(axis=0)[None],
                                                  centre + half / 1.1, centre - half / 1.1]))
     return PosedRun(model, geometry, d, poses, centre, half, points, arrows(forces, half),
-                    _box(d, poses, extra))
+                    _box(d, poses, extra), scale)
 
 
 #: the longest contact-force arrow, in the scene's half-width
@@ -215,6 +222,7 @@ def frames(result, times, trail=90, contact_forces=False):
     for k, (t, R, r) in enumerate(run.poses):
         sc = realise(run.drawing, t, R, r, run.arrows[k] if run.arrows else ())
         sc.extent = (run.centre, run.half)
+        sc.caption = caption(run.deflection_scale)
         for name, pos, _, _ in sc.markers:
             trail_points.setdefault(name, []).append(pos)
         for name, arr in run.points.items():     # the run's output points leave trails too

@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import drawing as dr
+from .flexible_shapes import caption
 from .geometry import up_rotation
 
 
@@ -88,7 +89,8 @@ def view_data(run, title, speed, fps, trail):
     return {
         "unit": unit, "movers": len(run.poses[0][1]), "fps": fps, "trail": int(trail),
         "times": [int(round(t * 1000)) for t, _, _ in run.poses], "poses": poses,
-        "title": str(title) + (f"  ({speed:g}x)" if speed != 1 else ""),
+        "title": (str(title) + caption(run.deflection_scale)
+                  + (f"  ({speed:g}x)" if speed != 1 else "")),
         "names": [n for n, _, _, _ in markers],
         "markers": [{"at": _at(a, unit), "color": c, "size": round(max(s * 0.6, 3), 1)}
                     for _, a, c, s in markers],
