@@ -89,3 +89,80 @@ def test_packed_entry_takes_any_input_and_names_bad_ones():
     assert np.array_equal(m.forward_dynamics(q32, u), m.forward_dynamics(q32.astype(float), u))
     with pytest.raises(ModelError, match="length"):
         m.forward_dynamics(q[:-1], u)
+
+
+def _closed_chain(n):
+    """``n`` revolute links (axes z, gravity -y) hanging in a half circle from the origin,
+    the last one's end pinned back to the ground where it lies (as
+    ``benchmarks/constraints.py``'s chains): 5 equations of rank 2, mobility n - 2."""
+    length, mass, w = 2.0 / n, 2.0 / n, 0.02
+    angles = -np.pi / 2 + np.pi * (np.arange(n) + 0.5) / n
+    s = mb.System(f"closed chain of {n}", gravity=(0, -9.81, 0))
+    parent = "ground"
+    for i in range(n):
+        s.add_body(f"link{i}", mass=mass, com=(length / 2, 0, 0),
+                   inertia=(mass * 2 * w * w / 12, mass * (length ** 2 + w * w) / 12,
+                            mass * (length ** 2 + w * w) / 12))
+        s.add_joint(f"q{i}", "revolute", parent, f"link{i}", axis="z",
+                    position=(0 if i == 0 else length, 0, 0))
+        parent = f"link{i}"
+    end = length * np.array([np.cos(angles).sum(), np.sin(angles).sum()])
+    s.add_joint("close", "revolute", "ground", parent, axis="z",
+                position=(end[0], end[1], 0.0), child_position=(length, 0, 0))
+    m = s.compile()
+    q0 = np.concatenate([[angles[0]], np.diff(angles)])
+    return m, m.project(q0, np.random.default_rng(n).uniform(-0.5, 0.5, n))
+
+
+def test_articulated_route_on_a_long_closed_chain():
+    """A 40-link closed chain (``"auto"`` takes the articulated-body route from 16 speeds): the
+    accelerations satisfy ``M u' - f = G^T lam`` (the efforts lie in the row space of
+    ``G``, by the recursive Newton-Euler inverse dynamics) and ``G u' = gamma`` (by
+    differences of ``G u``), and equal the mass-matrix route's and the Newton-Euler
+    system's."""
+    m, (q, u) = _closed_chain(40)
+    ud = m.forward_dynamics(q, u)
+    assert np.array_equal(ud, m.forward_dynamics(q, u, method="articulated"))
+    effort = m.effort_array(q, u, ud)
+    G = m.constraint_jacobian(q)
+    Uq, sv, _ = np.linalg.svd(G.T, full_matrices=False)
+    basis = Uq[:, sv > 1e-9 * sv[0]]
+    assert np.abs(effort - basis @ (basis.T @ effort)).max() <= 1e-12 * np.abs(effort).max()
+    h, qd = 1e-6, m.coordinate_rates(q, u)
+    Gdot_u = (m.constraint_jacobian(q + h * qd) - m.constraint_jacobian(q - h * qd)) @ u / (2 * h)
+    assert np.abs(G @ ud + Gdot_u).max() <= 1e-6 * (1 + np.abs(G @ ud).max())
+    for method in ("jourdain", "newton-euler"):
+        other = m.forward_dynamics(q, u, method=method)
+        assert np.abs(ud - other).max() <= 1e-9 * np.abs(ud).max(), method
+
+
+@pytest.mark.parametrize("path, case", [("models/andrews_squeezer.toml", None),
+                                        ("models/four_bar.toml", "free"),
+                                        ("models/four_bar.toml", "motor")])
+def test_articulated_route_equals_the_mass_matrix_route(path, case):
+    """``method="articulated"`` (``kernels.loop_articulated``: the tree's articulated-body
+    factors, one light solve per independent row, no mass matrix) against the mass-matrix
+    route to 1e-10, drives and motors included; with rows chosen that are dependent (a zero
+    row, as near a singular configuration) it hands over to the mass-matrix route."""
+    from mbdyn.kernels.loop_solve import ROWS
+    scene = mb.load_model(path, case)
+    m = scene.model
+    q, u = m.project(scene.q0, scene.u0 + 0.2)
+    ref = m.forward_dynamics(q, u, method="jourdain")
+    art = m.forward_dynamics(q, u, method="articulated")
+    assert np.abs(art - ref).max() <= 1e-10 * (1 + np.abs(ref).max())
+    G = m.constraint_jacobian(q)
+    zero = [k for k in range(G.shape[0]) if not G[k].any()]
+    info = m._con[7]
+    if zero:
+        try:                                          # a run's rows, one of them zero
+            info[2] = m.constraint_rank(q)[0]
+            m.project(q, u)                           # chooses the rows
+            info[ROWS + 1] = zero[0]
+            again = m.forward_dynamics(q, u, method="articulated")
+            assert np.abs(again - ref).max() <= 1e-10 * (1 + np.abs(ref).max())
+        finally:
+            info[2] = info[ROWS] = -1.0
+    y = np.concatenate([q, u])
+    assert np.allclose(m.state_derivative(0.0, y, method="articulated")[m.nq:], ref,
+                       rtol=0, atol=1e-10 * (1 + np.abs(ref).max()))

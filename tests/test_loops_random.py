@@ -3,7 +3,8 @@ joints of every kind, placed so that the loops close at the tree's random state.
 the constraint Jacobian and ``gamma`` against finite differences of the residuals, the
 constrained accelerations against the equations they must satisfy, and Jourdain with
 multipliers against Newton-Euler with reaction unknowns (accelerations and the reaction
-components the motion determines, to 1e-10)."""
+components the motion determines, to 1e-10) and against the articulated-body route
+(accelerations)."""
 from __future__ import annotations
 
 import numpy as np
@@ -120,6 +121,9 @@ def test_random_closed_mechanism(seed):
     # reaction components
     ne = m.forward_dynamics(q, u, t, method="newton-euler")
     assert np.abs(ud - ne).max() <= 1e-10 * (1 + np.abs(ud).max())
+    # the articulated-body route (kernels.loop_articulated): no mass matrix at all
+    art = m.forward_dynamics(q, u, t, method="articulated")
+    assert np.abs(ud - art).max() <= 1e-10 * (1 + np.abs(ud).max())
     r1 = m.reactions(q, u, t)
     r2 = m.reactions(q, u, t, method="newton-euler")
     unique = m.reaction_uniqueness(q, t)

@@ -13,6 +13,7 @@ import numpy as np
 
 from ..errors import ModelError, SimulationError
 from ..kernels import constrained as kc
+from ..kernels import loop_articulated as kla
 from ..kernels.loop_solve import RANK_TOLERANCE
 from .inputs import plain
 
@@ -71,12 +72,29 @@ def mobility(model, q, t=0.0):
     return model.nu - model.constraint_rank(q, t)[0]
 
 
-def constrained_accelerations(model, q, u, t=0.0):
-    """``u'`` of the closed mechanism, ``M u' = f + G^T lam``, ``G u' = gamma``; the
-    minimum-norm multipliers stay in the workspace (``multipliers``).  One compiled call
-    on the packed arrays: float64 arrays as they come, anything else converted and
-    checked first."""
-    kernel = kc.constrained_accelerations_packed
+#: a closed mechanism's forward dynamics take the articulated-body route (``"auto"``)
+#: from this many free speeds on: below it the mass matrix and its factor cost less than
+#: the unit solves (``kernels.loop_articulated``; docs/performance.md, "Closed loops")
+LOOP_ARTICULATED_FROM = 16
+
+
+def loop_route(model, method):
+    """``"jourdain"`` or ``"articulated"``: the route ``method`` stands for on a closed
+    mechanism (``"auto"``: by its number of free speeds)."""
+    if method == "auto":
+        return "articulated" if model.nu >= LOOP_ARTICULATED_FROM else "jourdain"
+    return method
+
+
+def constrained_accelerations(model, q, u, t=0.0, route="jourdain"):
+    """``u'`` of the closed mechanism, ``M u' = f + G^T lam``, ``G u' = gamma``: by the
+    mass matrix (``route="jourdain"``; the minimum-norm multipliers stay in the
+    workspace, ``multipliers``) or by the articulated-body algorithm (``"articulated"``,
+    O(n) per independent constraint row, multipliers a basic solution; near a singular
+    configuration it hands over to the mass matrix).  One compiled call on the packed
+    arrays: float64 arrays as they come, anything else converted and checked first."""
+    kernel = (kla.constrained_articulated_packed if route == "articulated"
+              else kc.constrained_accelerations_packed)
     status = None
     if not model._python_inputs and plain(q, model.nq) and plain(u, model.nu):
         try:
@@ -90,6 +108,8 @@ def constrained_accelerations(model, q, u, t=0.0):
             status = kernel(*model._packed, *model._con_packed, q, u)
         except ZeroDivisionError:
             raise model._division_by_zero(q, t) from None
+    if status == -3:                             # dependent rows: decided with M
+        return constrained_accelerations(model, q, u, t)
     if status >= 0:
         model._raise_singular(q, t, status)
     if status == -2:

@@ -11,6 +11,7 @@ import numpy as np
 from ..errors import ModelError
 from ..kernels import packed as kp
 from .inputs import plain as _plain
+from .constrained import loop_route
 from .loop_newton_euler import loop_newton_euler
 
 
@@ -34,10 +35,11 @@ def forward_dynamics(model, q, u, t=0.0, method="auto"):
     solved by LU (``"newton-euler-dense"``).  All four solve the same equations;
     ``"auto"`` (the default) takes the fastest at the model's size (``formulation``,
     docs/performance.md)."""
+    if model._con is not None and method in ("auto", "jourdain", "articulated"):
+        # closed loops: G u' = gamma, by the mass matrix or the articulated bodies
+        return model._constrained_accelerations(q, u, t, loop_route(model, method))
     if method == "auto":
         method = model._auto_route
-    if model._con is not None and method in ("jourdain", "articulated"):
-        return model._constrained_accelerations(q, u, t)     # closed loops: G u' = gamma
     if model._con is not None and method in ("newton-euler", "newton-euler-dense"):
         return loop_newton_euler(model, q, u, t)[0]
     if method in ("jourdain", "articulated"):
@@ -98,6 +100,7 @@ def state_derivative(model, t, y, method="auto"):
     """``[q', u']`` for the state ``y = [q, u]`` in one compiled call: ``q' = N(q) u``
     (``coordinate_rates``) and ``u'`` as ``forward_dynamics`` gives it (``method``:
     ``"auto"``, ``"jourdain"`` or ``"articulated"``).  Returns a new array."""
+    route = loop_route(model, method) if model._con is not None else None
     if method == "auto":
         method = model._auto_route
     try:
@@ -111,7 +114,7 @@ def state_derivative(model, t, y, method="auto"):
     if model._con is not None:
         ydot = np.empty(model.nq + model.nu)
         q, u = y[:model.nq], y[model.nq:]
-        ydot[model.nq:] = model._constrained_accelerations(q, u, t)
+        ydot[model.nq:] = model._constrained_accelerations(q, u, t, route)
         ydot[:model.nq] = model.coordinate_rates(q, u)
         return ydot
     if method == "jourdain":

@@ -246,7 +246,7 @@ def workspace(model, joints, loop_joints=0):
     # joint: a fixed joint's)
     model._scratch = np.zeros(max(ke.scratch_size(n, nu, model._nu_full),
                                   getattr(model, "_force_work", 0),
-                                  kc.loop_work(nu, 6 * loop_joints) if loop_joints else 0))
+                                  kc.loop_work(n, nu, 6 * loop_joints) if loop_joints else 0))
     model._slots = np.array(model._free_joint_slots, np.int64).reshape(-1, 5)
 
 
@@ -323,9 +323,9 @@ def constraints(model, loop_joints):
     full_workspace(model)          # the constraints' Jacobian reads the full JR, JT
     con_int, con_data, labels, owners, prim_owner = pack_constraints(model, loop_joints)
     m = constraint_count(con_int)
-    if model._scratch.size < kc.loop_work(model.nu, m):
+    if model._scratch.size < kc.loop_work(model.n_frames, model.nu, m):
         raise RuntimeError(f"model {model.name!r}: the scratch holds {model._scratch.size} "
-                           f"floats, the loops need {kc.loop_work(model.nu, m)}")
+                           f"floats, the loops need {kc.loop_work(model.n_frames, model.nu, m)}")
     model.constraint_rows = labels
     model._row_joint, model._prim_joint = owners, prim_owner
     con_int = np.ascontiguousarray(con_int, np.int64)

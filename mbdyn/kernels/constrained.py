@@ -144,10 +144,12 @@ def constraint_state(tree, state, motion, con, scratch):
                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma)
 
 
-def loop_work(nu, m):
+def loop_work(n, nu, m):
     """Floats of the model's scratch a closed mechanism's evaluation and projection take
-    after the tree's kernels (at most ``m`` constraint rows, ``nu`` free speeds)."""
-    return max(ROW_WORK + m * nu, solve_work(nu, m))
+    after the tree's kernels (``n`` frames, ``nu`` free speeds, at most ``m`` constraint
+    rows), by either route (``loop_articulated.articulated_work``)."""
+    return max(ROW_WORK + m * nu, solve_work(nu, m),
+               12 * n + 2 * nu * m + m * m + 5 * m + 6)
 
 
 def con_floats(nprim, m, nu):

@@ -1,0 +1,241 @@
+"""A closed mechanism's forward dynamics by the articulated-body algorithm: O(n) per
+independent constraint row, for large trees closed by a few loops.
+
+``M u' = f + G^T lam``, ``G u' = gamma`` without forming ``M`` (O(n nu^2)) or factoring it
+(O(nu^3)): the tree's ``u0 = M^-1 f`` by the articulated-body algorithm
+(``evaluate.articulated_accelerations``), which leaves its factors -- per joint ``U = IA S``
+and the Cholesky factor of ``D = S^T IA S`` -- so that ``M^-1 tau`` for another
+generalized force ``tau`` costs two light sweeps (``unit_solve``: no velocities, no
+gravity, no inertia updates).  Then, on ``r`` independent rows ``c`` of ``G``:
+
+    ``X = M^-1 G_c^T`` (r sweeps),  ``(G_c X) lam_c = gamma_c - G_c u0``,  ``u' = u0 + X lam_c``.
+
+The rows: during a run, those the last projection chose (its rank known); else a
+column-pivoted QR of ``G^T`` (``rank_qr.pivoted_qr``, the same tolerance as the mass-matrix
+route's).  ``u'`` is unique; ``lam`` is a basic solution (zero on the rows left out), not
+the minimum-norm one -- reactions take the mass-matrix route (``constrained``).
+
+``G`` needs the Jacobians of the frames the loop joints join, which the articulated-body
+kinematics do not make (they skip the full Jacobians): ``jacobian_of`` builds those
+frames' rows from their ancestors' motion subspaces ``S``, O(depth) each.
+"""
+import numpy as np
+from numba import njit
+
+from .constrained import con_views
+from .constraints import _constraint_rows
+from .evaluate import articulated_accelerations
+from .joints import NU
+from .loop_solve import RANK_TOLERANCE, ROWS
+from .packed import _scatter, _views
+from .rank_qr import pivoted_qr
+from .views import UNCOUNTED, c_view
+
+
+@njit(cache=True, inline="always")
+def jacobian_of(i, parent, kind, ucol, r, S, JR, JT):
+    """``JR[i]``, ``JT[i]`` (3 x nu, world axes): frame ``i``'s angular velocity and its
+    origin's velocity per free speed, from each ancestor joint's motion subspace ``S[k]``
+    (its frame's angular and origin velocity per unit speed) moved to ``O_i``."""
+    for a_ in range(3):
+        for col in range(JR.shape[2]):
+            JR[i, a_, col] = 0.0
+            JT[i, a_, col] = 0.0
+    k = i
+    while k >= 0:
+        if ucol[k] >= 0:
+            d0, d1, d2 = r[i, 0] - r[k, 0], r[i, 1] - r[k, 1], r[i, 2] - r[k, 2]
+            for j in range(NU[kind[k]]):
+                col = ucol[k] + j
+                w0, w1, w2 = S[k, 0, j], S[k, 1, j], S[k, 2, j]
+                JR[i, 0, col], JR[i, 1, col], JR[i, 2, col] = w0, w1, w2
+                JT[i, 0, col] = S[k, 3, j] + w1 * d2 - w2 * d1
+                JT[i, 1, col] = S[k, 4, j] + w2 * d0 - w0 * d2
+                JT[i, 2, col] = S[k, 5, j] + w0 * d1 - w1 * d0
+        k = parent[k]
+
+
+@njit(cache=True, inline="always")
+def _joint_solve(Dl, i, k, x):
+    """``x <- D_i^-1 x``, ``D_i = L L^T`` with ``L`` in ``Dl[i, :k, :k]``."""
+    for a_ in range(k):
+        s = x[a_]
+        for b_ in range(a_):
+            s -= Dl[i, a_, b_] * x[b_]
+        x[a_] = s / Dl[i, a_, a_]
+    for a_ in range(k - 1, -1, -1):
+        s = x[a_]
+        for b_ in range(a_ + 1, k):
+            s -= Dl[i, b_, a_] * x[b_]
+        x[a_] = s / Dl[i, a_, a_]
+
+
+@njit(cache=True, inline="always")
+def unit_solve(parent, kind, ucol, r, S, U, Dl, tau, x, p, acc, v6):
+    """``x = M^-1 tau`` by the articulated-body factors ``U``, ``Dl`` of the last
+    ``articulated_body`` call: the algorithm's two sweeps for the generalized force
+    ``tau`` alone (no velocities, no gravity, no applied loads).  ``p``, ``acc`` (n x 6)
+    and ``v6`` (6): scratch."""
+    n = parent.shape[0]
+    for i in range(n):
+        for a_ in range(6):
+            p[i, a_] = 0.0
+    for i in range(n - 1, -1, -1):                  # leaves to root: the bias forces
+        col0 = ucol[i]
+        k = NU[kind[i]] if col0 >= 0 else 0
+        if k:
+            for j in range(k):
+                s = tau[col0 + j]
+                for a_ in range(6):
+                    s -= S[i, a_, j] * p[i, a_]
+                v6[j] = s
+            _joint_solve(Dl, i, k, v6)
+            for j in range(k):
+                x[col0 + j] = v6[j]                  # D^-1 (tau - S^T p), kept for below
+                for a_ in range(6):
+                    p[i, a_] += U[i, a_, j] * v6[j]
+        q = parent[i]
+        if q >= 0:
+            d0, d1, d2 = r[i, 0] - r[q, 0], r[i, 1] - r[q, 1], r[i, 2] - r[q, 2]
+            f0, f1, f2 = p[i, 3], p[i, 4], p[i, 5]
+            p[q, 0] += p[i, 0] + d1 * f2 - d2 * f1
+            p[q, 1] += p[i, 1] + d2 * f0 - d0 * f2
+            p[q, 2] += p[i, 2] + d0 * f1 - d1 * f0
+            p[q, 3] += f0
+            p[q, 4] += f1
+            p[q, 5] += f2
+    for i in range(n):                              # root to leaves: the accelerations
+        q = parent[i]
+        if q >= 0:
+            d0, d1, d2 = r[i, 0] - r[q, 0], r[i, 1] - r[q, 1], r[i, 2] - r[q, 2]
+            acc[i, 0], acc[i, 1], acc[i, 2] = acc[q, 0], acc[q, 1], acc[q, 2]
+            acc[i, 3] = acc[q, 3] + acc[q, 1] * d2 - acc[q, 2] * d1
+            acc[i, 4] = acc[q, 4] + acc[q, 2] * d0 - acc[q, 0] * d2
+            acc[i, 5] = acc[q, 5] + acc[q, 0] * d1 - acc[q, 1] * d0
+        else:
+            for a_ in range(6):
+                acc[i, a_] = 0.0
+        col0 = ucol[i]
+        if col0 >= 0:
+            k = NU[kind[i]]
+            for j in range(k):
+                s = 0.0
+                for a_ in range(6):
+                    s += U[i, a_, j] * acc[i, a_]
+                v6[j] = s
+            _joint_solve(Dl, i, k, v6)
+            for j in range(k):
+                x[col0 + j] -= v6[j]
+                for a_ in range(6):
+                    acc[i, a_] += S[i, a_, j] * x[col0 + j]
+
+
+@njit(**UNCOUNTED)
+def constrained_articulated(tree, body, state, loads, motion, work, ud, con, scratch):
+    """``ud``: the closed mechanism's ``u'`` by the articulated-body algorithm (the module
+    docstring); the groups as ``evaluate.articulated_accelerations`` takes them, ``con``
+    the constraints' workspace, ``scratch`` sized by ``constrained.loop_work``.  Returns -1, the speed where a degree of freedom has no
+    inertia, -2 when ``ud`` holds NaN or Inf, or -3 when the chosen rows are (nearly)
+    dependent: a singular configuration, which the mass-matrix route decides."""
+    # long: the rows, the unit solves and the small solve share one scratch layout
+    parent, kind, _, _, _, _, qoff, uoff, ucol, _, _ = tree
+    qfull, ufull, udfull = state
+    R, r, w, v, alpha, a, JR, JT, S, F, N = motion
+    U, Dl = work[3], work[4]
+    con_int, con_data, phi, psi, G, gamma, lam, info = con
+    pivot = articulated_accelerations(tree, body, state, loads, motion, work, ud, scratch)
+    if pivot != -1:
+        return pivot
+    for k in range(con_int.shape[0]):
+        for f in (con_int[k, 1], con_int[k, 2]):
+            if f >= 0:
+                jacobian_of(f, parent, kind, ucol, r, S, JR, JT)
+    _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
+                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch)
+    m, nu, n = G.shape[0], G.shape[1], parent.shape[0]
+    for i in range(m):
+        lam[i] = 0.0
+    if m == 0:
+        info[0], info[1] = 0.0, 1.0
+        return -1
+    p, acc2 = c_view(scratch, 0, (n, 6)), c_view(scratch, 6 * n, (n, 6))
+    at = 12 * n
+    X, A = c_view(scratch, at, (m, nu)), c_view(scratch, at + m * nu, (m, m))
+    at += m * nu + m * m
+    res, rows, Rd = (c_view(scratch, at, (m,)), c_view(scratch, at + m, (m,)),
+                     c_view(scratch, at + 2 * m, (m,)))
+    beta, v6 = c_view(scratch, at + 3 * m, (m,)), c_view(scratch, at + 4 * m, (6,))
+    GT = c_view(scratch, at + 4 * m + 6, (nu, m))
+    keep = int(info[2])
+    if keep >= 0 and info[ROWS] == keep:            # a run: the projection's rows
+        nr = keep
+        for j in range(nr):
+            rows[j] = info[ROWS + 1 + j]
+    else:
+        for i in range(nu):
+            for j in range(m):
+                GT[i, j] = G[j, i]
+        nr = pivoted_qr(GT, RANK_TOLERANCE, rows, Rd, beta)[0]
+        if keep >= 0:
+            nr = min(nr, keep)
+    for i in range(m):
+        s = gamma[i]
+        for k in range(nu):
+            s -= G[i, k] * ud[k]
+        res[i] = s
+    for j in range(nr):                             # X_j = M^-1 G_cj^T
+        unit_solve(parent, kind, ucol, r, S, U, Dl, G[int(rows[j])], X[j], p, acc2, v6)
+    first = 0.0
+    for i in range(nr):                             # A = G_c M^-1 G_c^T, Cholesky
+        gi = G[int(rows[i])]
+        for j in range(i + 1):
+            s = 0.0
+            for k in range(nu):
+                s += gi[k] * X[j, k]
+            A[i, j] = s
+        first = max(first, A[i, i])
+    for k in range(nr):
+        d = A[k, k]
+        for j in range(k):
+            d -= A[k, j] * A[k, j]
+        if not d > 1e-12 * first:
+            return -3
+        A[k, k] = np.sqrt(d)
+        for i in range(k + 1, nr):
+            s = A[i, k]
+            for j in range(k):
+                s -= A[i, j] * A[k, j]
+            A[i, k] = s / A[k, k]
+    for i in range(nr):                             # A y = res_c, y into Rd
+        s = res[int(rows[i])]
+        for j in range(i):
+            s -= A[i, j] * Rd[j]
+        Rd[i] = s / A[i, i]
+    for i in range(nr - 1, -1, -1):
+        s = Rd[i]
+        for j in range(i + 1, nr):
+            s -= A[j, i] * Rd[j]
+        Rd[i] = s / A[i, i]
+    for j in range(nr):
+        lam[int(rows[j])] = Rd[j]
+        for k in range(nu):
+            ud[k] += X[j, k] * Rd[j]
+    info[0] = nr
+    info[1] = A[nr - 1, nr - 1] / np.sqrt(first) if nr and first > 0 else 1.0
+    for k in range(nu):
+        if not np.isfinite(ud[k]):
+            return -2
+    return -1
+
+
+@njit(**UNCOUNTED)
+def constrained_articulated_packed(fb, ib, t, forces, con_int, cf, q, u):
+    """Scatter ``q``, ``u``, then ``constrained_articulated`` on the packed arrays and the
+    constraints' buffer (the Python entry point of a large closed mechanism; ``u'`` in
+    the ``ud`` view)."""
+    _scatter(fb, ib, t, q, u)
+    tree, body, state, loads, _, motion, jourdain, art, scratch = _views(fb, ib, t, forces)
+    mass, com, inertia, _, gravity = body
+    return constrained_articulated(tree[:9] + art[:2], (mass, com, inertia, gravity), state,
+                                   loads, motion, art[2:8], jourdain[3],
+                                   con_views(con_int, cf, t[1]), scratch)
