@@ -23,17 +23,20 @@ loads but gravity), Andrews' squeezer (``models/andrews_squeezer.toml``, 7 bodie
 loop joints) and planar chains of n = 20 and 100 revolute links hanging in a half circle
 from the ground and closed back to the ground by one revolute loop joint.  Columns:
 
-* "Python entry": ``model.forward_dynamics(q, u)`` (method "jourdain", the route a
-  closed mechanism takes: ``M u' = f + G^T lam``, ``G u' = gamma``; for the tree
-  ``M u' = f``), timed with ``benchmarks/forward_dynamics.py``'s ``measure`` (blocks sized
-  to a time budget, rounds interleaved, garbage collector off; medians; the ratio is the
-  median of the per-round ratios).
+* "Python entry": ``model.forward_dynamics(q, u)`` (method "auto", the route a user
+  gets: for the closed mechanism ``M u' = f + G^T lam``, ``G u' = gamma`` by the mass
+  matrix below 16 free speeds, by the articulated bodies from 16 on; for the tree ``M u'
+  = f`` below 6, the articulated-body algorithm from 6 on), timed with
+  ``benchmarks/forward_dynamics.py``'s ``measure`` (blocks sized to a time budget, rounds
+  interleaved, garbage collector off; medians; the ratio is the median of the per-round
+  ratios).
 * "RK4 run, per evaluation": a fixed-step RK4 run (``mb.simulate(..., integrator="rk4",
-  dt=..., method="jourdain")``, the compiled loop) of each, ``stats["wall_time_s"] /
-  stats["rhs_evaluations"]``: the compiled cost of one right-hand side in a run, the
-  closed mechanism's including its share of the projection onto the constraints after
-  every step (one projection per 4 evaluations).  The two runs follow different motions
-  (the tree's links are free) with the same number of evaluations.
+  dt=...)``, the compiled loop, the "auto" route of each as above) of each,
+  ``stats["wall_time_s"] / stats["rhs_evaluations"]``: the compiled cost of one
+  right-hand side in a run, the closed mechanism's including its share of the projection
+  onto the constraints after every step (one projection per 4 evaluations).  The two runs
+  follow different motions (the tree's links are free) with the same number of
+  evaluations.
 * "kernel alone": the compiled kernel called in a loop from compiled code (no dispatch,
   no Python, no projection): ``kernels.constrained.constrained_accelerations`` for the
   closed mechanism, ``kernels.packed.jourdain_accelerations_packed`` for the tree.  These
@@ -304,7 +307,7 @@ def rk4_per_eval(mb, pairs, repeats):
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 r = mb.simulate(model, t_end, q, u, integrator="rk4", dt=dt,
-                                method="jourdain", decimate=max(1, steps // 4))
+                                decimate=max(1, steps // 4))
             return r.stats["wall_time_s"] / r.stats["rhs_evaluations"], r
         _, rl = run(loop)                 # warm-up (compiles the loop on a cold cache)
         run(tree)

@@ -166,3 +166,26 @@ def test_articulated_route_equals_the_mass_matrix_route(path, case):
     y = np.concatenate([q, u])
     assert np.allclose(m.state_derivative(0.0, y, method="articulated")[m.nq:], ref,
                        rtol=0, atol=1e-10 * (1 + np.abs(ref).max()))
+
+
+def test_runs_by_the_articulated_route():
+    """Compiled runs take the articulated-body route (``"auto"`` from 16 free speeds,
+    ``kernels.routes``' 29-array layout): a 20-link closed chain over 0.3 s by DOP853
+    follows the mass-matrix route's motion and stays on its constraints; a parallelogram
+    four-bar forced onto that route passes its singular configuration as the mass-matrix
+    route does (named, on the parallelogram branch)."""
+    m, (q, u) = _closed_chain(20)
+    assert m.formulation() == "articulated"
+    runs = {meth: mb.simulate(m, 0.3, q, u, integrator="DOP853", rtol=1e-10, atol=1e-12,
+                              method=meth) for meth in ("auto", "jourdain")}
+    assert runs["auto"].stats["compiled"]
+    assert np.abs(runs["auto"].q[-1] - runs["jourdain"].q[-1]).max() <= 1e-8
+    assert runs["auto"].stats["constraint_drift"] <= 1e-10
+    from loop_mechanisms import four_bar
+    fb = four_bar(a=0.1, b=0.3, c=0.1, d=0.3, g=0.0)
+    q, u = fb.assemble({"th2": 2.0}, {"th2": 3.0}, guess={"th3": -2.0, "th4": 2.0})
+    with pytest.warns(mb.SingularityWarning, match="singular configuration near t="):
+        res = mb.simulate(fb, 0.8, q, u, t_eval=np.linspace(0, 0.8, 81), method="articulated")
+    th2 = res.q[:, fb.coordinate_index("th2")]
+    assert abs(res.stats["singular_configuration"]["t"] - np.interp(np.pi, th2, res.t)) <= 0.011
+    np.testing.assert_allclose(res.q[:, fb.coordinate_index("th4")], th2, atol=1e-8)

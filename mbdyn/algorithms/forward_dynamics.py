@@ -85,10 +85,11 @@ def formulation(model, method="auto"):
     """The per-call route ``method`` stands for: ``"auto"`` is ``"jourdain"`` for fewer
     than ``ARTICULATED_FROM`` free speeds, else ``"articulated"`` (measured crossover,
     docs/performance.md); any other name is checked and returned."""
-    if method == "auto" or (method == "articulated" and model._con is not None):
-        # closed loops: M u' = f + G^T lam by the mass matrix (kernels.constrained)
-        if model._con is not None:
-            return "jourdain"
+    if model._con is not None and method in ("auto", "jourdain", "articulated"):
+        # closed loops: by the mass matrix, or the articulated bodies from
+        # LOOP_ARTICULATED_FROM free speeds on (kernels.constrained, loop_articulated)
+        return loop_route(model, method)
+    if method == "auto":
         return "jourdain" if model.nu < ARTICULATED_FROM else "articulated"
     if method not in METHODS:
         raise ModelError(f"unknown method {method!r}; use 'auto' or one of "

@@ -278,7 +278,7 @@ class Model:
         ws = (self._qfull, self._ufull, self._udfull, self._R, self._r, self._w, self._v,
               self._alpha, self._a, self._JR, self._JT, self._S, self._F, self._N, *work,
               self._scratch)
-        if method == "jourdain" and self._con is not None:
+        if self._con is not None:
             ws += self._con             # closed loops (kernels.routes), flat: numba's
             #                             parallel loops take no nested tuples
         return (self.nq, slots, quats, self._free_q, self._free_u, drive_q, drive_u,

@@ -18,14 +18,17 @@ from numba import config
 
 from .integrators import LOOPS
 
-#: the workspace entries of a closed mechanism's layout (26 arrays) that members share:
-#: its constraints' definitions (``con_int``, ``con_data``), read only
-SHARED = (18, 19)
+#: the workspace entries of a closed mechanism's layouts (26 arrays by the mass matrix, 29
+#: by the articulated bodies: the constraints' eight last) that members share, counted from
+#: the end: its constraints' definitions (``con_int``, ``con_data``), read only
+SHARED = (8, 7)
 
 
 def own_workspace(ws):
     """A private copy of the workspace arrays of ``Model.loop_arguments``."""
-    return tuple(a if len(ws) == 26 and k in SHARED else a.copy() for k, a in enumerate(ws))
+    closed = len(ws) in (26, 29)
+    return tuple(a if closed and len(ws) - k in SHARED else a.copy()
+                 for k, a in enumerate(ws))
 
 
 def batched_fixed_step(scheme, h, n_steps, h_last, Y0, table, table_last, nq, slots, quats,

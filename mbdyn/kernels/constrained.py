@@ -21,7 +21,8 @@ runs, whose rank is known, solve on rows instead (``loop_solve``).  When ``M`` i
 import numpy as np
 from numba import njit
 
-from .constraints import DATA, POINT, ROW_WORK, _constraint_rows, constraint_rows
+from .constraints import (DATA, POINT, ROW_WORK, _constraint_rows, constrained_jacobians,
+                          constraint_rows)
 from .evaluate import jourdain_accelerations
 from .joints import coordinate_rates
 from .kinematics import walk
@@ -93,6 +94,8 @@ def project_state(y, nq, slots, quats, free_q, free_u, tree, state, motion, con,
             ufull[free_u[k]] = y[nq + k]
         walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull,
              ufull, udfull, R, r, w, v, alpha, a, JR, JT, S, scratch)
+        if anc_ptr.shape[0] == 0:        # the articulated-body layout: no full Jacobians
+            constrained_jacobians(con_int, parent, kind, ucol, r, S, JR, JT)
         _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
                          R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch)
         if residual_norm(phi) <= PROJECTION_TOLERANCE:

@@ -16,43 +16,20 @@ route's).  ``u'`` is unique; ``lam`` is a basic solution (zero on the rows left 
 the minimum-norm one -- reactions take the mass-matrix route (``constrained``).
 
 ``G`` needs the Jacobians of the frames the loop joints join, which the articulated-body
-kinematics do not make (they skip the full Jacobians): ``jacobian_of`` builds those
-frames' rows from their ancestors' motion subspaces ``S``, O(depth) each.
+kinematics do not make (they skip the full Jacobians): ``constraints.constrained_jacobians``
+builds those frames' rows from their ancestors' motion subspaces ``S``, O(depth) each.
 """
 import numpy as np
 from numba import njit
 
 from .constrained import con_views
-from .constraints import _constraint_rows
+from .constraints import _constraint_rows, constrained_jacobians
 from .evaluate import articulated_accelerations
 from .joints import NU
-from .loop_solve import RANK_TOLERANCE, ROWS
+from .loop_solve import PASSAGE_TOLERANCE, RANK_TOLERANCE, ROWS
 from .packed import _scatter, _views
 from .rank_qr import pivoted_qr
 from .views import UNCOUNTED, c_view
-
-
-@njit(cache=True, inline="always")
-def jacobian_of(i, parent, kind, ucol, r, S, JR, JT):
-    """``JR[i]``, ``JT[i]`` (3 x nu, world axes): frame ``i``'s angular velocity and its
-    origin's velocity per free speed, from each ancestor joint's motion subspace ``S[k]``
-    (its frame's angular and origin velocity per unit speed) moved to ``O_i``."""
-    for a_ in range(3):
-        for col in range(JR.shape[2]):
-            JR[i, a_, col] = 0.0
-            JT[i, a_, col] = 0.0
-    k = i
-    while k >= 0:
-        if ucol[k] >= 0:
-            d0, d1, d2 = r[i, 0] - r[k, 0], r[i, 1] - r[k, 1], r[i, 2] - r[k, 2]
-            for j in range(NU[kind[k]]):
-                col = ucol[k] + j
-                w0, w1, w2 = S[k, 0, j], S[k, 1, j], S[k, 2, j]
-                JR[i, 0, col], JR[i, 1, col], JR[i, 2, col] = w0, w1, w2
-                JT[i, 0, col] = S[k, 3, j] + w1 * d2 - w2 * d1
-                JT[i, 1, col] = S[k, 4, j] + w2 * d0 - w0 * d2
-                JT[i, 2, col] = S[k, 5, j] + w0 * d1 - w1 * d0
-        k = parent[k]
 
 
 @njit(cache=True, inline="always")
@@ -130,13 +107,48 @@ def unit_solve(parent, kind, ucol, r, S, U, Dl, tau, x, p, acc, v6):
                     acc[i, a_] += S[i, a_, j] * x[col0 + j]
 
 
+@njit(cache=True, inline="always")
+def _schur_cholesky(G, X, rows, nr, A):
+    """``A = G_c X^T`` (``G_c M^-1 G_c^T`` on the rows ``rows[:nr]``), its Cholesky factor
+    in the lower triangle.  Returns the largest diagonal entry and how many pivots stayed
+    above ``PASSAGE_TOLERANCE^2`` of it (``nr`` when all did)."""
+    nu = G.shape[1]
+    first = 0.0
+    for i in range(nr):
+        gi = G[int(rows[i])]
+        for j in range(i + 1):
+            s = 0.0
+            for k in range(nu):
+                s += gi[k] * X[j, k]
+            A[i, j] = s
+        first = max(first, A[i, i])
+    for k in range(nr):
+        d = A[k, k]
+        for j in range(k):
+            d -= A[k, j] * A[k, j]
+        if not d > PASSAGE_TOLERANCE * PASSAGE_TOLERANCE * first:
+            return first, k
+        A[k, k] = np.sqrt(d)
+        for i in range(k + 1, nr):
+            s = A[i, k]
+            for j in range(k):
+                s -= A[i, j] * A[k, j]
+            A[i, k] = s / A[k, k]
+    return first, nr
+
+
 @njit(**UNCOUNTED)
 def constrained_articulated(tree, body, state, loads, motion, work, ud, con, scratch):
     """``ud``: the closed mechanism's ``u'`` by the articulated-body algorithm (the module
     docstring); the groups as ``evaluate.articulated_accelerations`` takes them, ``con``
-    the constraints' workspace, ``scratch`` sized by ``constrained.loop_work``.  Returns -1, the speed where a degree of freedom has no
-    inertia, -2 when ``ud`` holds NaN or Inf, or -3 when the chosen rows are (nearly)
-    dependent: a singular configuration, which the mass-matrix route decides."""
+    the constraints' workspace, ``scratch`` sized by ``constrained.loop_work``.  Returns
+    -1, the speed where a degree of freedom has no inertia, -2 when ``ud`` holds NaN or
+    Inf, or -3 outside a run when the independent rows are nearly dependent (a singular
+    configuration, which the mass-matrix route decides).  During a run (``info[2]``, the
+    rank it holds), rows that no longer span are chosen again, and near a singular
+    configuration the weakest are dropped for the evaluation: the motion follows its
+    inertia there and the projection after the step puts it back on the constraints, as
+    the mass-matrix route does (``loop_solve.PASSAGE_TOLERANCE``)."""
     # long: the rows, the unit solves and the small solve share one scratch layout
     parent, kind, _, _, _, _, qoff, uoff, ucol, _, _ = tree
     qfull, ufull, udfull = state
@@ -146,10 +158,7 @@ def constrained_articulated(tree, body, state, loads, motion, work, ud, con, scr
     pivot = articulated_accelerations(tree, body, state, loads, motion, work, ud, scratch)
     if pivot != -1:
         return pivot
-    for k in range(con_int.shape[0]):
-        for f in (con_int[k, 1], con_int[k, 2]):
-            if f >= 0:
-                jacobian_of(f, parent, kind, ucol, r, S, JR, JT)
+    constrained_jacobians(con_int, parent, kind, ucol, r, S, JR, JT)
     _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
                      R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch)
     m, nu, n = G.shape[0], G.shape[1], parent.shape[0]
@@ -166,46 +175,36 @@ def constrained_articulated(tree, body, state, loads, motion, work, ud, con, scr
                      c_view(scratch, at + 2 * m, (m,)))
     beta, v6 = c_view(scratch, at + 3 * m, (m,)), c_view(scratch, at + 4 * m, (6,))
     GT = c_view(scratch, at + 4 * m + 6, (nu, m))
-    keep = int(info[2])
-    if keep >= 0 and info[ROWS] == keep:            # a run: the projection's rows
-        nr = keep
-        for j in range(nr):
-            rows[j] = info[ROWS + 1 + j]
-    else:
-        for i in range(nu):
-            for j in range(m):
-                GT[i, j] = G[j, i]
-        nr = pivoted_qr(GT, RANK_TOLERANCE, rows, Rd, beta)[0]
-        if keep >= 0:
-            nr = min(nr, keep)
     for i in range(m):
         s = gamma[i]
         for k in range(nu):
             s -= G[i, k] * ud[k]
         res[i] = s
-    for j in range(nr):                             # X_j = M^-1 G_cj^T
-        unit_solve(parent, kind, ucol, r, S, U, Dl, G[int(rows[j])], X[j], p, acc2, v6)
-    first = 0.0
-    for i in range(nr):                             # A = G_c M^-1 G_c^T, Cholesky
-        gi = G[int(rows[i])]
-        for j in range(i + 1):
-            s = 0.0
-            for k in range(nu):
-                s += gi[k] * X[j, k]
-            A[i, j] = s
-        first = max(first, A[i, i])
-    for k in range(nr):
-        d = A[k, k]
-        for j in range(k):
-            d -= A[k, j] * A[k, j]
-        if not d > 1e-12 * first:
-            return -3
-        A[k, k] = np.sqrt(d)
-        for i in range(k + 1, nr):
-            s = A[i, k]
-            for j in range(k):
-                s -= A[i, j] * A[k, j]
-            A[i, k] = s / A[k, k]
+    keep = int(info[2])
+    chosen = keep >= 0 and info[ROWS] == keep
+    for attempt in range(2):
+        if attempt == 0 and chosen:                 # a run: the projection's rows
+            nr = keep
+            for j in range(nr):
+                rows[j] = info[ROWS + 1 + j]
+        else:                                       # the independent rows by QR
+            for i in range(nu):
+                for j in range(m):
+                    GT[i, j] = G[j, i]
+            nr = pivoted_qr(GT, RANK_TOLERANCE, rows, Rd, beta)[0]
+            if keep >= 0:
+                nr = min(nr, keep)
+        for j in range(nr):                         # X_j = M^-1 G_cj^T
+            unit_solve(parent, kind, ucol, r, S, U, Dl, G[int(rows[j])], X[j], p, acc2, v6)
+        first, good = _schur_cholesky(G, X, rows, nr, A)
+        if good == nr:
+            break
+        if attempt == 0 and chosen:
+            continue                                # those rows no longer span: choose
+        if keep < 0:
+            return -3                               # outside a run: the mass matrix decides
+        nr = good       # a run near a singular configuration: inertia decides the rest
+        break
     for i in range(nr):                             # A y = res_c, y into Rd
         s = res[int(rows[i])]
         for j in range(i):

@@ -14,6 +14,7 @@ from numba.extending import overload
 
 from .constrained import constrained_accelerations, project_state_call
 from .evaluate import articulated_accelerations, jourdain_accelerations
+from .loop_articulated import constrained_articulated
 
 
 @njit(cache=True, inline="always")
@@ -37,10 +38,21 @@ def _accelerations_route(tree, body, loads, ws, ud):
     arrays (``M``, ``f``, ``L``, scratch last) for ``M u' = f``, 26 (the same and the
     eight arrays of the constraints, ``Model._con``) for a closed mechanism, 21 (the articulated-body
     workspace, then the scratch; ``tree`` then has empty ancestor lists) for the
-    articulated-body algorithm.  A run compiles only its own route.  A closed
+    articulated-body algorithm, 29 (that and the constraints) for a closed mechanism by
+    the articulated bodies (``loop_articulated``).  A run compiles only its own route.  A closed
     mechanism's accelerations are inlined here too (a call with their fifty arrays cost a
     tenth of a four-bar's evaluation); the kernels they call that allocate are counted
     explicitly (``constraint_rows``, the solves)."""
+    if len(ws) == 29:
+        def articulated_loop_route(tree, body, loads, ws, ud):
+            (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S, F, N, IA, pA, cb, U, Dl,
+             acc, scratch) = ws[:21]
+            mass, com, inertia, _, gravity = body
+            return constrained_articulated(tree, (mass, com, inertia, gravity),
+                                           (qfull, ufull, udfull), loads,
+                                           (R, r, w, v, alpha, a, JR, JT, S, F, N),
+                                           (IA, pA, cb, U, Dl, acc), ud, ws[21:], scratch)
+        return articulated_loop_route
     if len(ws) == 26:
         def constrained_route(tree, body, loads, ws, ud):
             (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S, F, N, M, f, L,
@@ -69,6 +81,19 @@ def _accelerations_route(tree, body, loads, ws, ud):
     return articulated_route
 
 
+def _constraints_and_scratch(ws):
+    """A closed mechanism's workspace: its constraints (the last eight arrays) and the
+    scratch before them."""
+    raise NotImplementedError("compiled code only")
+
+
+@overload(_constraints_and_scratch, inline="always")
+def _constraints_and_scratch_layout(ws):
+    if len(ws) == 29:                    # articulated bodies: 21 arrays, then the eight
+        return lambda ws: (ws[21:], ws[20])
+    return lambda ws: (ws[18:], ws[17])  # the mass matrix: 18 arrays, then the eight
+
+
 def finish_step(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_u, tree, ws):
     """After a step: unit quaternions and, for a closed mechanism, the state projected
     back onto the constraint manifold (``kernels.constrained.project_state``) with the
@@ -82,7 +107,7 @@ def _finish_step_route(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q,
     """Chosen by the workspace's layout, as ``accelerations``: a tree only normalises; a
     closed mechanism's projection is the entry point Python calls
     (``constrained.project_state_call``, counted: it allocates), once a step."""
-    if len(ws) == 26:
+    if len(ws) == 26 or len(ws) == 29:
         def project_route(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_u,
                           tree, ws):
             qfull, ufull, udfull = ws[0], ws[1], ws[2]
@@ -91,8 +116,9 @@ def _finish_step_route(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q,
                 ufull[drive_u[d]] = drive_vals[d, 1]
                 udfull[drive_u[d]] = drive_vals[d, 2]
             _normalize(y, quats)
+            con, scratch = _constraints_and_scratch(ws)
             steps = project_state_call(y, nq, slots, quats, free_q, free_u, tree,
-                                       (qfull, ufull, udfull), ws[3:14], ws[18:], ws[17])
+                                       (qfull, ufull, udfull), ws[3:14], con, scratch)
             return 5 if steps < 0 else 0
         return project_route
 
