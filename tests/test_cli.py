@@ -176,6 +176,19 @@ def test_info_json_lists_drives_and_warnings(capsys):
     assert d["bodies"][0]["massless"] and not d["bodies"][2]["massless"]
     assert d["warnings"] == [] and d["cases"] == ["at_rest"] and d["case"] is None
     assert d["parameters"]["Omega"] == pytest.approx(np.pi / 4)
+    assert d["route"]["route"] == "jourdain" and d["route"]["method"] == "auto"
+
+
+def test_info_names_the_route_a_run_takes(capsys):
+    """``mbdyn info`` says which formulation ``method = auto`` resolves to and what it
+    solves: the mass matrix with multipliers for a small closed mechanism, the
+    articulated bodies when asked."""
+    andrews = str(MODELS / "andrews_squeezer.toml")
+    assert main(["info", andrews]) == 0
+    assert "route        jourdain (method auto): M u' = f + G^T lam" in capsys.readouterr().out
+    assert main(["info", andrews, "--set", "simulation.method=articulated", "--json"]) == 0
+    route = json.loads(capsys.readouterr().out)["route"]
+    assert route["route"] == "articulated" and "independent constraint row" in route["solves"]
 
 
 @pytest.mark.parametrize("argv, code, fragment", [

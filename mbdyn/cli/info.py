@@ -74,11 +74,36 @@ def describe(scene):
         "effects": dict(model.effects),
         "events": list(scene.event_specs), "initial": scene.initial_state,
         "simulation": dict(scene.settings),
+        "route": _route(model, scene.settings.get("method") or "auto"),
         "outputs": outputs_spec(scene),
         "warnings": list(scene.warnings),
         "loops": describe_loops(scene) if model.has_loops else None,
         "urdf": scene.urdf,
     }
+
+
+#: what each route solves, as ``mbdyn info`` says it
+ROUTES = {"jourdain": "M u' = f by the mass matrix and its Cholesky factor",
+          "articulated": "the articulated-body algorithm, O(n)",
+          "newton-euler": "the Newton-Euler system with reactions, in tree order",
+          "newton-euler-dense": "the Newton-Euler system with reactions, dense LU",
+          "symbolic": "the derived equations, evaluated by sympy's lambdify"}
+LOOP_ROUTES = {"jourdain": "M u' = f + G^T lam, G u' = gamma by the mass matrix",
+               "articulated": "the articulated-body algorithm, one solve per independent "
+                              "constraint row"}
+
+
+def _route(model, method):
+    """The route a run of ``method`` takes (``"auto"`` resolved by the model's size), and
+    what it solves; None when the model has no choice to say (flexible bodies)."""
+    try:
+        route = model.formulation(method) if method != "symbolic" else method
+    except Exception:               # noqa: BLE001 -- a method the run itself will refuse
+        return None
+    text = (LOOP_ROUTES if model.has_loops else ROUTES).get(route, ROUTES.get(route))
+    if getattr(model, "flexible_bodies", ()):
+        text = "M u' = f with the flexible bodies' modal terms, in Python (numpy)"
+    return {"method": method, "route": route, "solves": text}
 
 
 def describe_loops(scene):
@@ -272,6 +297,10 @@ def _run_settings(d, w):
     s = d["simulation"]
     w("simulation   " + ", ".join(f"{k} = {fmt(v) if not isinstance(v, str) else v}"
                                   for k, v in s.items() if v is not None) + "\n")
+    r = d.get("route")
+    if r:
+        w(f"route        {r['route']}" + (" (method auto)" if r["method"] == "auto" else "")
+          + f": {r['solves']}\n")
 
 
 def _outputs(d, w):
