@@ -25,8 +25,9 @@ ASSEMBLY_TOLERANCE = 1e-10
 def held_speeds(model, held_coordinates):
     """Speed indices whose coordinate is held: a 1-DoF or Euler coordinate holds its own
     rate, a quaternion coordinate its joint's rotation, a free joint's x, y, z its
-    velocity components."""
-    held = set()
+    velocity components, a flexible body's modal coordinate its rate."""
+    names, rates = _modal_pairs(model)
+    held = {model.speed_index(r) for c, r in zip(names, rates) if c in held_coordinates}
     for code, q0, nq, u0, nu in model._free_joint_slots:
         for k in range(nq):
             if model.coordinates[q0 + k] not in held_coordinates:
@@ -70,8 +71,14 @@ def assemble(model, initial=None, initial_speeds=None, guess=None, t=0.0):
     return q, u
 
 
+def _modal_pairs(model):
+    """The flexible bodies' modal coordinates and their rates (none on a rigid model)."""
+    names = tuple(getattr(model, "modal_coordinates", ()))
+    return names, tuple(model.speeds[model.nu - len(names):])
+
+
 def _rate_pairs(model):
-    names, rates = [], []
+    names, rates = (list(x) for x in _modal_pairs(model))
     for j in model.elements[1]:
         if j.drive is None and j.kind in ("revolute", "prismatic", "euler"):
             names.extend(j.coordinates)

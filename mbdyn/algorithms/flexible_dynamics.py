@@ -157,7 +157,7 @@ def state_derivative(model, t, y, method="jourdain"):
                          f"{model.nq + model.nu} (q then u), got shape {y.shape}")
     q, u = y[:model.nq], y[model.nq:]
     return np.concatenate([coordinate_rates(model, q, u),
-                           forward_dynamics(model, q, u, t, method)])
+                           model.forward_dynamics(q, u, t, method)])
 
 
 def coordinate_rates(model, q, u):
@@ -259,7 +259,7 @@ def modal_power(model, q, u, t=0.0):
     ``-eta'^T D eta'`` and, with ``geometric_stiffening``, ``-eta'^T K_G eta`` (its
     axial part reads the frame's acceleration, so ``u'`` is computed)."""
     q, u = split(model, q, u)
-    ud = forward_dynamics(model, q, u, t) if model.stiffening else None
+    ud = model.forward_dynamics(q, u, t) if model.stiffening else None
     q, u = model._extended(q, u)
     P = sum(-u[fb.u] @ fb.damping @ u[fb.u] for fb in model._flex)
     if not model.stiffening:

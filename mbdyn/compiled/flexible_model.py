@@ -18,6 +18,7 @@ import numpy as np
 
 from ..algorithms import flexible_dynamics as flex
 from ..algorithms import flexible_forces
+from ..algorithms import flexible_loops as flex_loops
 from ..errors import ModelError
 from .flexible_states import remapped_layout, state_map
 from .model import Model
@@ -184,7 +185,20 @@ class FlexibleModel(Model):
 
     @property
     def has_loops(self):
-        return False
+        """True when loop joints close the tree (at points of flexible bodies or not)."""
+        return self.tree._con is not None
+
+    #: runs in Python project every fixed step onto the loops' constraints (the compiled
+    #: loops do so for rigid mechanisms)
+    projects_steps = True
+
+    def forward_dynamics(self, q, u, t=0.0, method="jourdain"):
+        """``u'``: of ``M u' = f``, or with loops of ``M u' = f + G^T lam``,
+        ``G u' = gamma`` (``algorithms.flexible_loops``)."""
+        if self.has_loops:
+            self.formulation(method)
+            return flex_loops.constrained_accelerations(self, q, u, t)[0]
+        return flex.forward_dynamics(self, q, u, t, method)
 
     def formulation(self, method="auto"):
         """``"jourdain"`` for ``"auto"`` and ``"jourdain"``; the other routes are refused."""
@@ -250,7 +264,6 @@ class FlexibleModel(Model):
         return self.tree.load_power(*self._tree_state(q, u)[:2], t) + \
             flex.element_energies(self, q, u, t)[2]
 
-    forward_dynamics = flex.forward_dynamics
     state_derivative = flex.state_derivative
     coordinate_rates = flex.coordinate_rates
     mass_matrix = flex.mass_matrix
@@ -259,6 +272,10 @@ class FlexibleModel(Model):
     momentum = flex.momentum
     mass_matrix_condition = flex.mass_matrix_condition
     _check_at_rest = flex.check_at_rest
+    constraint_residuals = flex_loops.constraint_residuals
+    constraint_jacobian = flex_loops.constraint_jacobian
+    multipliers = flex_loops.multipliers
+    project = flex_loops.project
 
     newton_euler = _not_yet("newton_euler")
     reactions = _not_yet("reactions")
