@@ -25,7 +25,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError, NonFiniteError, SingularMassMatrixError
-from ..flexible.invariants import floating_frame_mass_matrix, quadratic_velocity_vector
+from ..flexible.invariants import (cross3, floating_frame_mass_matrix,
+                                   quadratic_velocity_vector)
 from .flexible_forces import body_map, generalized_forces
 from .flexible_forces import energies as _element_energies
 
@@ -59,7 +60,7 @@ def body_forces(model, fb, eta, eta_dot, omega, a_b, Mb):
          if tree.gyroscopic and omega.any() else np.zeros(6 + fb.n))
     g = tree._R[fb.frame].T @ tree.gravity
     Q[:3] += inv.mass * g
-    Q[3:6] += np.cross(inv.first_moment + inv.modal_first_moment @ eta, g)
+    Q[3:6] += cross3(inv.first_moment + inv.modal_first_moment @ eta, g)
     Q[6:] += inv.modal_first_moment.T @ g - fb.stiffness @ eta - fb.damping @ eta_dot
     if fb.spin:                     # a rotor's spin, its frame not spinning
         Q[6:] -= fb.spin * (fb.gyroscopic @ eta_dot)
