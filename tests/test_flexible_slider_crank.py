@@ -129,6 +129,19 @@ def test_initial_accelerations_and_multiplier_against_the_test_set():
             assert abs(ours["rod_m4"] / A0["rod_m4"] - 1) > 0.1
 
 
+def test_the_model_files_initial_state_is_the_test_sets():
+    """The file's [initial] and [initial_speeds] (a modal coordinate's name standing for
+    its rate) give the published state; the loop gives the slider and the rod's turn."""
+    scene = _scene()
+    m, q, u = scene.model, scene.q0, scene.u0
+    for c in ("rod_m1", "rod_m2", "rod_m3", "rod_m4"):
+        assert q[m.coordinate_index(c)] == Y0[c]
+        assert u[m.speed_index(f"{c}_dot")] == V0[c]
+    assert q[m.coordinate_index("x3")] == pytest.approx(Y0["x3"], abs=5e-10)   # 9 digits
+    assert u[m.speed_index("phi2_dot")] + OMEGA == pytest.approx(V0["phi2"], abs=1e-7)
+    assert u[m.speed_index("x3_dot")] == pytest.approx(V0["x3"], abs=1e-12)
+
+
 # ------------------------------------------------------------------ the reference
 def _at_the_end(scene, published=False):
     m = scene.model
