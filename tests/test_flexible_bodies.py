@@ -217,8 +217,8 @@ def test_only_the_jourdain_route_and_the_python_integrators():
             mb.simulate(m, 0.01, method=method)
     with pytest.raises(ModelError, match="symbolic layer does not know flexible"):
         mb.simulate(m, 0.01, method="symbolic")
-    with pytest.raises(ModelError, match="reactions is not there yet"):
-        m.reactions(m.default_coordinates(), np.zeros(m.nu))
+    with pytest.raises(ModelError, match="inverse_dynamics is not there yet"):
+        m.inverse_dynamics(m.default_coordinates(), np.zeros(m.nu), np.zeros(m.nu))
     res = mb.simulate(m, 0.01, {"beam_m1": 1e-4}, integrator="rk4", dt=1e-4)
     assert res.stats["method"] == "jourdain" and np.all(np.isfinite(res.q))
 

@@ -19,6 +19,7 @@ import numpy as np
 from ..algorithms import flexible_dynamics as flex
 from ..algorithms import flexible_forces
 from ..algorithms import flexible_loops as flex_loops
+from ..algorithms import flexible_reactions as flex_reactions
 from ..errors import ModelError
 from .flexible_states import remapped_layout, state_map
 from .model import Model
@@ -277,11 +278,17 @@ class FlexibleModel(Model):
     multipliers = flex_loops.multipliers
     project = flex_loops.project
 
+    reactions = flex_reactions.reactions
+    reaction_uniqueness = flex_reactions.reaction_uniqueness
+
+    def reaction_array(self, q, u, t=0.0, frame="world"):
+        """The tree joints' reactions as one array, a row per joint of ``joints``."""
+        out = self.reactions(q, u, t, frame=frame)
+        return np.array([np.concatenate(out[name]) for name in self.joints])
+
     newton_euler = _not_yet("newton_euler")
-    reactions = _not_yet("reactions")
     inverse_dynamics = _not_yet("inverse_dynamics")
     inverse_dynamics_along = _not_yet("inverse_dynamics_along")
-    drive_efforts = _not_yet("drive_efforts (the energy balance of a driven model)")
     lowlevel = _not_yet("the low-level compiled entry")
     loop_arguments = _not_yet("the compiled loops")
 
