@@ -102,7 +102,7 @@ def project_state(y, nq, slots, quats, free_q, free_u, tree, state, motion, con,
             break
         if steps == PROJECTION_ITERATIONS:
             return -1
-        min_norm_step(G, phi, int(info[2]), du, info)
+        min_norm_step(G, phi, int(info[2]), du, info, scratch)
         coordinate_rates(y[:nq], du, slots, dq)
         for k in range(nq):
             y[k] -= dq[k]
@@ -112,7 +112,7 @@ def project_state(y, nq, slots, quats, free_q, free_u, tree, state, motion, con,
             for k in range(4):
                 y[i + k] /= nrm
         steps += 1
-    ratio = min_norm_step(G, psi, int(info[2]), du, info)
+    ratio = min_norm_step(G, psi, int(info[2]), du, info, scratch)
     for k in range(nu):
         y[nq + k] -= du[k]
     if info[2] >= 0:                 # a run: the rank here, for the next step's stages
@@ -157,7 +157,7 @@ def loop_work(n, nu, m):
 
 def con_floats(nprim, m, nu):
     """Floats of the constraints' buffer (``con_views``)."""
-    return nprim * DATA + 4 * m + m * nu + 6 + m
+    return nprim * DATA + 4 * m + m * nu + 7 + m
 
 
 @njit(inline="always", **UNCOUNTED)
@@ -173,7 +173,7 @@ def con_views(con_int, cf, nu):
     return (con_int, c_view(cf, 0, (nprim, DATA)), cf[at:at + m], cf[at + m:at + 2 * m],
             c_view(cf, at + 2 * m, (m, nu)), cf[at + 2 * m + m * nu:at + 3 * m + m * nu],
             cf[at + 3 * m + m * nu:at + 4 * m + m * nu],
-            cf[at + 4 * m + m * nu:at + 5 * m + m * nu + 6])
+            cf[at + 4 * m + m * nu:at + 5 * m + m * nu + 7])
 
 
 @njit(**UNCOUNTED)
