@@ -26,7 +26,8 @@ from .constraints import (DATA, POINT, ROW_WORK, _constraint_rows, constrained_j
 from .evaluate import jourdain_accelerations
 from .joints import coordinate_rates
 from .kinematics import walk
-from .loop_solve import augmented_solve, constrained_solve, min_norm_step, rank_of, solve_work
+from .loop_solve import (ROWS, augmented_solve, chosen_solve, constrained_solve,
+                         min_norm_step, rank_of, solve_work)
 from .packed import _scatter, _views
 from .views import UNCOUNTED, c_view, untracked
 
@@ -49,6 +50,15 @@ def constrained_accelerations(tree, body, state, loads, motion, jourdain, con, s
     con_int, con_data, phi, psi, G, gamma, lam, info = con
     pivot = jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch)
     # the scratch is free once M and f are made (loop_work: sized for the rows and solves)
+    if pivot == -1 and info[2] > 0 and info[ROWS] == info[2]:
+        # a run: only the rows its last projection chose, and the solve on them
+        _constraint_rows(con_int, con_data, tree[8], tree[6], tree[7], qfull, ufull,
+                         udfull, R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch,
+                         info[ROWS + 1:], int(info[ROWS]))
+        if chosen_solve(L, ud, G, gamma, lam, info, scratch):
+            return _finite(ud)
+        info[ROWS] = -1.0            # no longer independent: every row, pivoted, until the
+                                     # next projection chooses again
     _constraint_rows(con_int, con_data, tree[8], tree[6], tree[7], qfull, ufull, udfull,
                      R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch)
     if pivot >= 0:
@@ -58,6 +68,12 @@ def constrained_accelerations(tree, body, state, loads, motion, jourdain, con, s
             return pivot
     elif pivot == -1:
         constrained_solve(M, L, ud, G, gamma, lam, info, scratch)
+    return _finite(ud)
+
+
+@njit(cache=True, inline="always")
+def _finite(ud):
+    """-1 (done) when every entry of ``ud`` is finite, else -2."""
     for k in range(ud.shape[0]):
         if not np.isfinite(ud[k]):
             return -2

@@ -169,13 +169,32 @@ def _pivoted_solve(L, ud, G, gamma, lam, info, keep, work):
     info[1] = A[rank - 1, rank - 1] / np.sqrt(first) if rank and first > 0 else 1.0
 
 
+@njit(**UNCOUNTED)
+def chosen_solve(L, ud, G, gamma, lam, info, work):
+    """A run's constrained ``ud`` (holding ``M^-1 f``) on the rows its last projection
+    chose (``_chosen_rows_solve``), when it has chosen as many as the rank it holds.
+    Returns False, having changed nothing but ``work``, when there are no such rows or
+    they are no longer independent enough (then the caller evaluates every row and
+    pivots: ``constrained_solve``)."""
+    keep = int(info[2])
+    if keep <= 0 or info[ROWS] != keep:
+        return False
+    m, nu = G.shape[0], G.shape[1]
+    Y, A = c_view(work, 0, (nu, keep)), c_view(work, nu * keep, (keep, keep))
+    at = nu * keep + keep * keep
+    res, x, z = (c_view(work, at, (m,)), c_view(work, at + m, (keep,)),
+                 c_view(work, at + m + keep, (nu,)))
+    return _chosen_rows_solve(L, ud, G, gamma, lam, info, keep, Y, A, res, x, z)
+
+
 @njit(cache=True, inline="always")
 def _schur_rows(L, ud, G, gamma, rows, r, Y, A, res):
-    """The residual ``res = gamma - G ud`` (every row); for the rows ``rows[:r]`` (row
-    numbers, as floats) ``Y = L^-1 G_r^T`` and ``A = Y^T Y`` (both triangles), the Schur
+    """For the rows ``rows[:r]`` (row numbers, as floats): the residual ``res = gamma -
+    G ud`` at those rows, ``Y = L^-1 G_r^T`` and ``A = Y^T Y`` (both triangles), the Schur
     complement ``G_r M^-1 G_r^T``.  Returns ``A``'s largest diagonal entry."""
-    m, nu = G.shape[0], G.shape[1]
-    for i in range(m):
+    nu = G.shape[1]
+    for j in range(r):
+        i = int(rows[j])
         s = gamma[i]
         for k in range(nu):
             s -= G[i, k] * ud[k]
