@@ -215,7 +215,7 @@ def test_the_jourdain_and_newton_euler_routes_and_the_python_integrators():
     assert m.formulation("newton-euler") == "newton-euler"
     with pytest.raises(ModelError, match="not 'articulated'"):
         mb.simulate(m, 0.01, method="articulated")
-    with pytest.raises(ModelError, match="symbolic layer does not know flexible"):
+    with pytest.raises(ModelError, match="generated right-hand side does not take flex"):
         mb.simulate(m, 0.01, method="symbolic")
     with pytest.raises(ModelError, match="inverse_dynamics is not there yet"):
         m.inverse_dynamics(m.default_coordinates(), np.zeros(m.nu), np.zeros(m.nu))
