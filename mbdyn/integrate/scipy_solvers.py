@@ -28,6 +28,7 @@ def run(plan):
     g_old = event_values(plan.events, model, plan.t0, plan.y0) if plan.events else None
     found, steps, failure = [], 0, None
     recent = collections.deque(maxlen=budgets.PROJECTION_STEPS)
+    project = model.has_loops and plan.integrator.removeprefix("scipy-") in EXPLICIT
     while solver.status == "running":
         t_prev, y_prev = solver.t, solver.y.copy()
         try:
@@ -44,6 +45,12 @@ def run(plan):
         failure = plan.monitor.check(solver.t, solver.y)
         if failure:
             break
+        if project:
+            try:
+                _project(solver, model)
+            except (NonFiniteError, SingularMassMatrixError, SimulationError) as exc:
+                failure = describe_failure(model, exc, solver.t, solver.y)
+                break
         stop_at = None
         if plan.events:
             try:
@@ -68,6 +75,22 @@ def run(plan):
         info["failure"] = failure
     ts, ys = samples.arrays(solver)
     return Outcome(ts, ys, found, info)
+
+
+#: scipy's explicit Runge-Kutta pairs: one-step methods whose state is ``y`` and its
+#: derivative ``f`` alone, so a projected ``y`` (and ``f`` evaluated there) starts the next
+#: step as any other state would.  Radau and BDF (BDF is multistep) are not projected.
+EXPLICIT = ("RK23", "RK45", "DOP853")
+
+
+def _project(solver, model):
+    """The accepted step's end put back onto a closed mechanism's constraints, as the
+    compiled integrators do after every step (``Model.project``), and the derivative
+    there, which the next step starts from (first-same-as-last)."""
+    nq = model.nq
+    q, u = model.project(solver.y[:nq], solver.y[nq:], solver.t)
+    solver.y = np.concatenate([q, u])
+    solver.f = solver.fun(solver.t, solver.y)
 
 
 def _start(plan):
