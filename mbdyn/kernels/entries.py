@@ -14,14 +14,14 @@ one array less to type and unbox at every call; the force table is its view
 ``Model`` methods call the packed kernels themselves, with ``None`` for a model without
 force elements (a first call compiles less).
 """
-from numba import njit
+from numba import njit, typeof
 
 from . import inverse as ki
 from . import packed as kp
 from .views import UNCOUNTED, c_view
 
 #: a size that does not fit the model
-WRONG_SIZE = -3
+WRONG_SIZE = kp.WRONG_SIZE
 
 #: ``(fb, ib, q, u, out)``
 FORWARD_SIGNATURE = "int64(float64[::1], int64[::1], float64[::1], float64[::1], float64[::1])"
@@ -32,6 +32,7 @@ INVERSE_SIGNATURE = ("int64(float64[::1], int64[::1], float64[::1], float64[::1]
 MASS_MATRIX_SIGNATURE = "int64(float64[::1], int64[::1], float64[::1], float64[:, ::1])"
 
 _COMPILED = {}
+_FROZEN = {}
 
 
 def entry(function, signature):
@@ -40,6 +41,28 @@ def entry(function, signature):
     if function not in _COMPILED:
         _COMPILED[function] = njit(signature, **UNCOUNTED)(function)
     return _COMPILED[function]
+
+
+def frozen(kernel, args):
+    """``kernel`` (a compiled dispatcher) restricted to the specialization it already has
+    for the types of ``args``: a dispatcher that never compiles, so that an argument of
+    any other type (a list, another dtype, a non-contiguous or read-only array) raises
+    ``TypeError`` in numba's own dispatch, at no cost to a call that fits -- the ordinary
+    ``Model`` methods call it before any check of their own, and check (and convert)
+    only when it refuses.  Made once per kernel and types, from the compiled code (no
+    compile); ``None`` when ``kernel`` has no such specialization."""
+    types = tuple(typeof(a) for a in args)
+    key = (kernel, types)
+    if key not in _FROZEN:
+        compiled = kernel.overloads.get(types)
+        if compiled is None:
+            return None
+        options = {k: v for k, v in kernel.targetoptions.items() if k != "nopython"}
+        clone = njit(**options)(kernel.py_func)
+        clone.add_overload(compiled)
+        clone.disable_compile()
+        _FROZEN[key] = clone
+    return _FROZEN[key]
 
 
 def inverse_dynamics(fb, ib, q, u, ud, tau):

@@ -21,7 +21,7 @@ from .articulated import _add_shifted_inertia, _spatial_inertia, world_inertia
 from .evaluate import drop_velocity_products, kinematics_and_loads
 from .joints import NU
 from .kinematics import walk
-from .packed import FREE_Q, FREE_U, UDFULL, UFULL, _scatter, _views
+from .packed import FREE_Q, FREE_U, UDFULL, UFULL, WRONG_SIZE, _scatter, _views
 from .views import UNCOUNTED, c_view
 
 #: floats of scratch the two kernels need
@@ -139,7 +139,10 @@ def inverse_dynamics_packed(fb, ib, t, forces, q, u, ud, tau):
     """Scatter ``q``, ``u``, ``u'``; the kinematics with those rates and the applied loads;
     then ``recursive_newton_euler``: ``tau`` (free speeds) and the joint wrenches in the
     ``W`` view.  ``forces``: the force table or None (``packed``).  Returns -1, or -2 when
-    ``tau`` holds NaN or Inf."""
+    ``tau`` holds NaN or Inf, or ``WRONG_SIZE`` for an argument of another size."""
+    nu = t[1]
+    if q.shape[0] != t[7] or u.shape[0] != nu or ud.shape[0] != nu or tau.shape[0] != nu:
+        return WRONG_SIZE
     _scatter(fb, ib, t, q, u)
     udfull, free_u = fb[t[UDFULL]:], ib[t[FREE_U]:]
     for k in range(ud.shape[0]):
@@ -169,9 +172,11 @@ def inverse_dynamics_packed(fb, ib, t, forces, q, u, ud, tau):
 def mass_matrix_packed(fb, ib, t, forces, q, M):
     """Scatter ``q`` (speeds zero), the kinematics, then ``composite_mass_matrix_s`` into
     ``M`` (nu x nu); ``forces`` is not read (the packed kernels' arguments).  Returns -1,
-    or -2 when ``M`` holds NaN or Inf."""
+    or -2 when ``M`` holds NaN or Inf, or ``WRONG_SIZE`` for an argument of another size."""
     ufull, free_u = fb[t[UFULL]:], ib[t[FREE_U]:]
     nu = t[1]
+    if q.shape[0] != t[7] or M.shape[0] != nu or M.shape[1] != nu:
+        return WRONG_SIZE
     tree, body, state, _, _, motion, _, art, scratch = _views(fb, ib, t, None)
     qfull = state[0]
     free_q = ib[t[FREE_Q]:]
