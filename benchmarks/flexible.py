@@ -15,6 +15,13 @@ The second table: the flexible rotor models/jeffcott_flexible.toml (16 modes) wi
 without its bearings and unbalance load at nodes (Python, ``algorithms.flexible_forces``),
 against the rigid models/jeffcott_rotor.toml (compiled): CPU time of blocks of 200
 evaluations, interleaved, medians.
+
+The third table: joints at nodes and closed loops through a flexible body (Python): a
+beam on a pin (3 modes) with and without a pendulum hanging from its tip (a node frame
+in the tree), and the flexible slider-crank models/flexible_slider_crank.toml (4 modes,
+the loop at the rod's tip: the constrained solve in Python) against the same with its
+rod rigid (``-flexibility_rod``: the compiled closed-loop route); with a run of its
+0.1 s at the file's tolerance.
 """
 import os
 
@@ -90,6 +97,48 @@ def node_elements(rounds=9, calls=200):
         print(f"| {k} | {v:.1f} | {v / base:.0f} |")
 
 
+def at_nodes(rounds=9, calls=100):
+    """Cost of a joint at a node and of a loop through a flexible body."""
+    import statistics
+
+    def pinned(pendulum):
+        s = mb.System("pinned beam", gravity=(0, -9.81, 0))
+        beam = {"length": 1.0, "elements": 8, "E": 7e10, "rho": 2700.0, "rect": [0.03, 0.02]}
+        s.add_body("beam", flexible={"beam": beam, "modes": 3})
+        s.add_joint("pin", "revolute", "ground", "beam", axis="z")
+        if pendulum:
+            s.add_body("bob", mass=0.5, com=(0, -0.2, 0), inertia=[1e-3] * 3)
+            s.add_joint("hang", "revolute", "beam", "bob", axis="z", position="tip")
+        return s.compile()
+    crank = ROOT / "models" / "flexible_slider_crank.toml"
+    models = {"beam on a pin, 3 modes": pinned(False),
+              "the same, a pendulum at its tip (node frame)": pinned(True),
+              "slider-crank, rod rigid (compiled closed loop)":
+                  mb.load_model(crank, effects="-flexibility_rod").model,
+              "flexible slider-crank, 4 modes (loop at the rod's tip)":
+                  mb.load_model(crank).model}
+
+    def block(m):
+        q, u = m.default_coordinates(), np.full(m.nu, 1e-3)
+        if m.has_loops:
+            q, u = m.project(q + 0.3, u)
+        return lambda: [m.forward_dynamics(q, u, 0.01) for _ in range(calls)]
+    cpu = interleaved_cpu({k: block(m) for k, m in models.items()}, rounds)
+    med = {k: statistics.median(v) / calls * 1e6 for k, v in cpu.items()}
+    print("\n| model | us CPU per forward_dynamics | ratio to the line above |")
+    print("|---|---|---|")
+    for k, (name, v) in enumerate(med.items()):
+        ratio = f"{v / list(med.values())[k - 1]:.2f}" if k % 2 else "-"
+        print(f"| {name} | {v:.1f} | {ratio} |")
+    from time import process_time
+    scene = mb.load_model(crank)
+    t0 = process_time()
+    res = scene.simulate()
+    print(f"\nflexible slider-crank, 0.1 s at rtol {scene.settings['rtol']:g}: "
+          f"{res.stats['rhs_evaluations']} evaluations, {process_time() - t0:.1f} s CPU")
+
+
 if __name__ == "__main__":
     main()
     node_elements()
+    at_nodes()

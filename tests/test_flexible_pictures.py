@@ -71,3 +71,25 @@ def test_rigid_bodies_and_flexibility_off_draw_nothing_more():
     assert deflection_scale(rigid, res.q) == 1.0
     assert flexible_primitives(rigid, rigid.kinematics(res.q[-1], res.u[-1]), res.q[-1]) == []
     assert "flexible" not in view_data(prepare(res, [0.0, 0.05]), "t", 1.0, 30.0, 10)["title"]
+
+
+def test_a_body_at_a_node_moves_the_modal_coordinates_in_the_state():
+    """With a pendulum at the beam's tip (a node frame) the modal coordinates sit
+    elsewhere in ``q`` than after the tree's: the drawing reads them by name; the tip's
+    segment ends at the deformed tip, drawn ``s`` times, the bob at the true one."""
+    s = mb.System("tip", gravity=(0, 0, -9.81))
+    s.add_body("beam", flexible={"beam": EB, "modes": 3})
+    s.add_joint("clamp", "fixed", "ground", "beam")
+    s.add_body("bob", mass=1.0, inertia=[1e-3] * 3)
+    s.add_joint("hang", "revolute", "beam", "bob", axis="y", position="tip")
+    m = s.compile()
+    assert m.coordinates[0] == "hang"
+    q = m.q_vector({"beam_m1": 2e-3, "hang": 0.3})
+    kin = m.kinematics(q)
+    prims = flexible_primitives(m, kin, q, 10.0)
+    tip = np.array([1.0, 0, 0]) + np.array([m.node_row(f"beam.tip.{c}", m.coordinates) @ q
+                                           for c in "xyz"])
+    (kind, (R, centre), size, _) = prims[-1]
+    end = centre + 0.5 * size[1] * R[:, 2]
+    assert np.allclose(end, [1.0, 0, 0] + 10.0 * (tip - [1.0, 0, 0]), atol=1e-3 * size[1])
+    assert np.allclose(kin.r[m.frame_index("bob")], tip, atol=1e-15)

@@ -25,8 +25,9 @@ ASSEMBLY_TOLERANCE = 1e-10
 def held_speeds(model, held_coordinates):
     """Speed indices whose coordinate is held: a 1-DoF or Euler coordinate holds its own
     rate, a quaternion coordinate its joint's rotation, a free joint's x, y, z its
-    velocity components."""
-    held = set()
+    velocity components, a flexible body's modal coordinate its rate."""
+    names, rates = _modal_pairs(model)
+    held = {model.speed_index(r) for c, r in zip(names, rates) if c in held_coordinates}
     for code, q0, nq, u0, nu in model._free_joint_slots:
         for k in range(nq):
             if model.coordinates[q0 + k] not in held_coordinates:
@@ -46,8 +47,10 @@ def assemble(model, initial=None, initial_speeds=None, guess=None, t=0.0):
     """``(q, u)`` that close every loop: ``initial`` (``{coordinate: value}``) and
     ``initial_speeds`` (``{speed: value}``; a 1-DoF coordinate's name stands for its rate)
     are held; the other coordinates start from ``guess`` (``{coordinate: value}``, else
-    zero) and are solved for.  Raises ``ModelError`` naming the loop joint and its
-    residual when the loops cannot be closed with the values held."""
+    zero) and are solved for.  A flexible body's modal coordinates and rates are held
+    too (at the values given, else zero) unless the coordinate is in ``guess``.  Raises
+    ``ModelError`` naming the loop joint and its residual when the loops cannot be
+    closed with the values held."""
     initial, initial_speeds, guess = dict(initial or {}), dict(initial_speeds or {}), \
         dict(guess or {})
     both = sorted(set(initial) & set(guess))
@@ -59,19 +62,30 @@ def assemble(model, initial=None, initial_speeds=None, guess=None, t=0.0):
     model.normalize_quaternions(q)
     if model._con is None:
         return q, u
+    # a flexible body's modal coordinates are held (at their values given, else 0) unless
+    # guessed: closing a loop by deflecting a body, stiffness unseen, is no assembly
+    modal, rates = _modal_pairs(model)
+    elastic = {c for c in modal if c not in guess}
     free = np.ones(model.nu, bool)
-    free[held_speeds(model, set(initial))] = False
+    free[held_speeds(model, set(initial) | elastic)] = False
     q = _close_positions(model, q, free, t)
     rate_names = dict(zip(*_rate_pairs(model)))
     held_u = {model.speed_index(rate_names.get(k, k)) for k in initial_speeds}
+    held_u |= {model.speed_index(r) for c, r in zip(modal, rates) if c in elastic}
     free_u = np.ones(model.nu, bool)
     free_u[sorted(held_u)] = False
     u = _close_speeds(model, q, u, free_u, t)
     return q, u
 
 
+def _modal_pairs(model):
+    """The flexible bodies' modal coordinates and their rates (none on a rigid model)."""
+    names = tuple(getattr(model, "modal_coordinates", ()))
+    return names, tuple(model.speeds[model.nu - len(names):])
+
+
 def _rate_pairs(model):
-    names, rates = [], []
+    names, rates = (list(x) for x in _modal_pairs(model))
     for j in model.elements[1]:
         if j.drive is None and j.kind in ("revolute", "prismatic", "euler"):
             names.extend(j.coordinates)

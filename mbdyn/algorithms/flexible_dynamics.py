@@ -25,7 +25,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError, NonFiniteError, SingularMassMatrixError
-from ..flexible.invariants import floating_frame_mass_matrix, quadratic_velocity_vector
+from ..flexible.invariants import (cross3, floating_frame_mass_matrix,
+                                   quadratic_velocity_vector)
 from .flexible_forces import body_map, generalized_forces
 from .flexible_forces import energies as _element_energies
 
@@ -59,7 +60,7 @@ def body_forces(model, fb, eta, eta_dot, omega, a_b, Mb):
          if tree.gyroscopic and omega.any() else np.zeros(6 + fb.n))
     g = tree._R[fb.frame].T @ tree.gravity
     Q[:3] += inv.mass * g
-    Q[3:6] += np.cross(inv.first_moment + inv.modal_first_moment @ eta, g)
+    Q[3:6] += cross3(inv.first_moment + inv.modal_first_moment @ eta, g)
     Q[6:] += inv.modal_first_moment.T @ g - fb.stiffness @ eta - fb.damping @ eta_dot
     if fb.spin:                     # a rotor's spin, its frame not spinning
         Q[6:] -= fb.spin * (fb.gyroscopic @ eta_dot)
@@ -73,20 +74,35 @@ def body_forces(model, fb, eta, eta_dot, omega, a_b, Mb):
 def terms(model, q, u, t=0.0):
     """``(M, f, A)`` at the state: the symmetric mass matrix ``M``, the forcing ``f`` and
     the matrix ``A`` that ``u'`` solves (``M`` plus the geometric stiffness's part in
-    ``u'``; ``M`` itself without it)."""
+    ``u'``; ``M`` itself without it).  With node frames, those of the extended state
+    (``extended_terms``) projected on the model's speeds: ``P^T M_x P``, ``P^T f_x``
+    (``compiled.flexible_states``)."""
     q, u = split(model, q, u)
+    M, f, A = extended_terms(model, *model._extended(q, u), t)
+    P = None if model._map is None else model._map.P
+    if P is None:
+        return M, f, A
+    PT = P.T
+    M, f = PT @ M @ P, PT @ f
+    return M, f, (M if A is None else PT @ A @ P)
+
+
+def extended_terms(model, qx, ux, t=0.0):
+    """``(M_x, f_x, A_x)`` over the extended speeds (the tree's, then the modal ones):
+    the tree's Jourdain terms and each flexible body's (module docstring); ``A_x`` is
+    ``M_x`` plus the stiffening's part in the accelerations (the same array without)."""
     tree = model.tree
-    nqt, nut = tree.nq, tree.nu
-    tree._jourdain_terms(q[:nqt], u[:nut], t)
-    M = np.zeros((model.nu, model.nu))
-    f = np.zeros(model.nu)
+    nqt, nut, nux = tree.nq, tree.nu, model._nux
+    tree._jourdain_terms(qx[:nqt], ux[:nut], t)
+    M = np.zeros((nux, nux))
+    f = np.zeros(nux)
     M[:nut, :nut] = tree._M
     f[:nut] = tree._f
     coupled = []                      # (rows, row-vector): the stiffening's part in u'
-    omegas = _angular_velocities(model, q, u, t)
+    omegas = _angular_velocities(model, qx, ux, t)
     for fb in model._flex:
-        eta, eta_dot = q[fb.q], u[fb.u]
-        B = body_map(tree, fb, u.size)
+        eta, eta_dot = qx[fb.q], ux[fb.u]
+        B = body_map(tree, fb, nux)
         RT = tree._R[fb.frame].T
         bias = np.concatenate([RT @ tree._a[fb.frame], RT @ tree._alpha[fb.frame]])
         Mb = body_matrix(fb, eta)
@@ -96,7 +112,7 @@ def terms(model, q, u, t=0.0):
         if model.stiffening and fb.axial.any():
             coupled.append((fb.u, np.outer(fb.axial @ eta, B[0])))
     if model._flex_elements:
-        f += generalized_forces(model, q, u, t)
+        f += generalized_forces(model, qx, ux, t)
     A = M
     if coupled:
         A = M.copy()
@@ -108,7 +124,8 @@ def terms(model, q, u, t=0.0):
 def _angular_velocities(model, q, u, t):
     """With the gyroscopic effect off the tree's kernels leave every frame's angular
     velocity at zero (``drop_velocity_products``); the stiffening needs the true one:
-    the frames' body-component angular velocities then, else ``None``."""
+    the frames' body-component angular velocities then, else ``None`` (``q``, ``u``:
+    extended)."""
     tree = model.tree
     if tree.gyroscopic or not model.stiffening:
         return None
@@ -141,14 +158,19 @@ def state_derivative(model, t, y, method="jourdain"):
                          f"{model.nq + model.nu} (q then u), got shape {y.shape}")
     q, u = y[:model.nq], y[model.nq:]
     return np.concatenate([coordinate_rates(model, q, u),
-                           forward_dynamics(model, q, u, t, method)])
+                           model.forward_dynamics(q, u, t, method)])
 
 
 def coordinate_rates(model, q, u):
     """``q' = N(q) u``: the tree's, then ``eta' `` as the modal speeds."""
     q, u = split(model, q, u)
     tree = model.tree
-    return np.concatenate([tree.coordinate_rates(q[:tree.nq], u[:tree.nu]), u[tree.nu:]])
+    if model._map is None:
+        return np.concatenate([tree.coordinate_rates(q[:tree.nq], u[:tree.nu]),
+                               u[tree.nu:]])
+    qx, ux = model._extended(q, u)
+    rates = tree.coordinate_rates(qx[:tree.nq], ux[:tree.nu])
+    return np.concatenate([rates[model._map.keep_q], u[model._map.keep_u.size:]])
 
 
 def mass_matrix(model, q, t=0.0):
@@ -190,7 +212,7 @@ def mass_matrix_condition(model, q, t=0.0):
 def energy(model, q, u, t=0.0):
     """Kinetic and potential energy ``(T, V)``: the tree's, plus each flexible body's
     ``1/2 w^T M_b(eta) w``, ``-g . (m r_0 + R c(eta))`` and ``1/2 eta^T K eta``."""
-    q, u = split(model, q, u)
+    q, u = model._extended(*split(model, q, u))
     tree = model.tree
     T, V = tree.energy(q[:tree.nq], u[:tree.nu], t)     # leaves the tree's kinematics
     for fb in model._flex:
@@ -208,7 +230,7 @@ def element_energies(model, q, u, t=0.0):
     bodies (``flexible_forces``), after a kinematics evaluation of the tree."""
     if not model._flex_elements:
         return 0.0, 0.0, 0.0
-    q, u = split(model, q, u)
+    q, u = model._extended(*split(model, q, u))
     model.tree._kinematics_kernel(q[:model.tree.nq], u[:model.tree.nu], t)
     return _element_energies(model, q, u, t)
 
@@ -218,7 +240,7 @@ def momentum(model, q, u, t=0.0):
     components: the tree's plus each flexible body's ``R [M_b w]_t`` and
     ``R [M_b w]_r + r_0 x p`` (its momenta about the frame origin, ``dT/dv_0``,
     ``dT/domega``)."""
-    q, u = split(model, q, u)
+    q, u = model._extended(*split(model, q, u))
     tree = model.tree
     p, L = tree.momentum(q[:tree.nq], u[:tree.nu], t)
     tree._kinematics_kernel(q[:tree.nq], u[:tree.nu], t)
@@ -238,16 +260,19 @@ def modal_power(model, q, u, t=0.0):
     ``-eta'^T D eta'`` and, with ``geometric_stiffening``, ``-eta'^T K_G eta`` (its
     axial part reads the frame's acceleration, so ``u'`` is computed)."""
     q, u = split(model, q, u)
+    ud = model.forward_dynamics(q, u, t) if model.stiffening else None
+    q, u = model._extended(q, u)
     P = sum(-u[fb.u] @ fb.damping @ u[fb.u] for fb in model._flex)
     if not model.stiffening:
         return float(P)
-    ud = forward_dynamics(model, q, u, t)      # leaves the tree's kinematics at (q, u)
-    tree = model.tree
+    if model._map is not None:
+        ud = model._map.P @ ud
+    tree = model.tree                  # its workspace: the forward dynamics' at (q, u)
     omegas = _angular_velocities(model, q, u, t)
     for fb in model._flex:
         RT = tree._R[fb.frame].T
         omega = RT @ tree._w[fb.frame] if omegas is None else omegas[fb.frame]
-        a_x = (body_map(tree, fb, model.nu)[0] @ ud + (RT @ tree._a[fb.frame])[0]
+        a_x = (body_map(tree, fb, model._nux)[0] @ ud + (RT @ tree._a[fb.frame])[0]
                - (RT @ tree.gravity)[0])
         Kg = (omega[1] ** 2 + omega[2] ** 2) * fb.centrifugal + a_x * fb.axial
         P -= u[fb.u] @ Kg @ q[fb.q]

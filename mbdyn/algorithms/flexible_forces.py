@@ -106,7 +106,7 @@ def _bearing_speed(model, el):
     if name in model.flexible:
         return ("value", _coefficients(el.params, model.flexible[name].spin))
     if name in model._speed_index:
-        return ("speed", model._speed_index[name])
+        return ("speed", model._extended_speed(model._speed_index[name]))
     params = getattr(model.tree, "parameters", None) or {}
     if name in params:
         return ("value", _coefficients(el.params, float(params[name])))
@@ -117,8 +117,9 @@ def _bearing_speed(model, el):
 
 def body_map(tree, fb, nu):
     """``B`` (6 + k, nu): the part of the body's ``(v_0, omega, eta')`` (body components)
-    that the model's free speeds make, after a kinematics evaluation of the tree (the
-    drives' part is in the frame's velocity, not here)."""
+    that the extended speeds make (the tree's, then the modal ones: ``nu`` of them), after
+    a kinematics evaluation of the tree (the drives' part is in the frame's velocity, not
+    here)."""
     i, nut = fb.frame, tree.nu
     RT = tree._R[i].T
     B = np.zeros((6 + fb.n, nu))
@@ -132,8 +133,9 @@ def point_state(model, sd, q, u, jacobians=True):
     """``(p, v, R, w, JT, JR)`` of a side after a tree evaluation at ``(q, u)``: world
     position and velocity of the point, orientation and angular velocity of the frame
     there (a flexible body's node turned by its small rotation), and the Jacobians
-    (3, nu) of its velocity and angular velocity (``None`` without ``jacobians``)."""
-    tree, nu = model.tree, model.nu
+    (3, nu) of its velocity and angular velocity over the extended speeds (``None``
+    without ``jacobians``); ``q``, ``u``: the extended state."""
+    tree, nu = model.tree, model._nux
     if sd.frame < 0:
         z = np.zeros((3, nu)) if jacobians else None
         return sd.s, np.zeros(3), np.eye(3), np.zeros(3), z, z
@@ -185,7 +187,8 @@ def wrenches(model, pk, q, u, t, jacobians=True):
 
 def _load(model, pk, states, q, u, t):
     (_, v, _, w, _, _), ld = states[0], pk.record
-    F, N = (np.asarray(part(t, q, u) if callable(part) else part, float)
+    outer = model._model_state(q, u) if any(callable(p) for p in pk.extra) else None
+    F, N = (np.asarray(part(t, *outer) if callable(part) else part, float)
             for part in pk.extra)
     if ld.in_body:
         frame = model.tree._R[pk.sides[0].frame] if pk.sides[0].frame >= 0 else np.eye(3)
@@ -260,9 +263,9 @@ _LAWS = {"load": _load, "spring-damper": _spring_damper, "bushing": _bushing,
 
 
 def generalized_forces(model, q, u, t):
-    """The sum of ``J_T^T F + J_R^T N`` over the packed elements (nu), after a tree
-    evaluation at ``(q, u, t)``."""
-    f = np.zeros(model.nu)
+    """The sum of ``J_T^T F + J_R^T N`` over the packed elements (the extended speeds),
+    after a tree evaluation at the extended state ``(q, u, t)``."""
+    f = np.zeros(model._nux)
     for pk in model._flex_elements:
         for (_, _, _, _, JT, JR), F, N in wrenches(model, pk, q, u, t)[0]:
             f += JT.T @ F + JR.T @ N

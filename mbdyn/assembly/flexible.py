@@ -1,8 +1,8 @@
 """Flexible bodies added to a ``System`` and checked across the tree at compile: their
 modal coordinates' names, their effects (``flexibility_BODY``, ``geometric_stiffening``),
-and what may attach to them in this step (joints at the frame origin; loads and
-spring-dampers, bushings and bearings at their nodes, evaluated in Python by
-``algorithms.flexible_forces``; no closed loops).
+and what may attach to them: joints, tree or loop joints, at any point (at its node
+frame, ``assembly.flexible_nodes``); loads and spring-dampers, bushings and bearings at
+their nodes, evaluated in Python by ``algorithms.flexible_forces``.
 """
 from __future__ import annotations
 
@@ -72,18 +72,7 @@ def flexible_on(system, order, state):
           if n in system._flexible and state[flexibility_effect(n)]]
     if not on:
         return on
-    if on and system._loop_joints:
-        raise ModelError(f"system {system.name!r}: closed loops with flexible bodies "
-                         f"({', '.join(b.name for b in on)}) are not there yet (the next "
-                         "step); switch their flexibility off or open the loops")
     names = {b.name for b in on}
-    for parent, child, joint in system.graph.edges(data="joint"):
-        if parent in names and np.any(np.asarray(joint.position, float) != 0.0):
-            raise ModelError(f"joint {joint.name!r}: it attaches {child!r} to the flexible "
-                             f"body {parent!r} at {joint.position.tolist()}; in this step "
-                             "joints attach to a flexible body at its frame origin only "
-                             "(position = [0, 0, 0], the beam's root); joints at its other "
-                             "nodes are the next step")
     for el in system._forces.values():
         touched = names.intersection(el.frames)
         if touched and "joint" not in el.params and el.kind not in KINDS:
@@ -147,14 +136,26 @@ def named_points(system, element, pairs, values):
     return out
 
 
-def flexible_model(model, on, state, loads=(), forces=()):
+def joint_point(system, element, frame, key, value):
+    """A joint's ``position`` (or ``child_position``) on ``frame``: as given, or, given
+    as a node's name (``"tip"``) on a flexible body, that node's position (body axes)."""
+    if not isinstance(value, str):
+        return value
+    record = system._flexible.get(frame)
+    if record is None:
+        raise ModelError(f"{element}: {key} = {value!r} names a node, but {frame!r} is not "
+                         "a flexible body; give three numbers (the point in its frame)")
+    return node_position(record.reduced, value, f"{element}: {key}").tolist()
+
+
+def flexible_model(model, on, state, loads=(), forces=(), nodes=()):
     """The compiled model: ``model`` itself without flexible bodies on; else the
-    ``FlexibleModel`` over it (its tree compiled with those bodies massless), with the
-    ``loads`` and ``forces`` at their points."""
+    ``FlexibleModel`` over it (its tree compiled with those bodies massless and the
+    ``nodes``' frames), with the ``loads`` and ``forces`` at their points."""
     if not on:
         return model
     return FlexibleModel(model, on, stiffening=state[STIFFENING], loads=loads,
-                         forces=forces)
+                         forces=forces, nodes=nodes)
 
 
 def massless(bodies, on):

@@ -27,6 +27,7 @@ from .actuation import add_actuator, add_controller, attach_plant, check_force
 from . import contacts
 from .composite import add_composite_joint
 from . import flexible as flex
+from .flexible_nodes import attach_at_nodes
 from .loops import add_loop_joint, check_loops, loop_bodies
 from ..elements.forces import GLOBAL_EFFECTS, make_force
 
@@ -170,6 +171,8 @@ class System:
         1-DoF joints through a massless frame (``assembly.composite``).
         """
         closing = {k for k in loop if k not in ("axis2",)}
+        element = f"joint {name!r}"
+        position = flex.joint_point(self, element, parent, "position", position)
         if kind in ("universal", "cylindrical") and not closing:
             return add_composite_joint(self, name, kind, parent, child, axis=axis,
                                        position=position, orientation=orientation,
@@ -177,9 +180,11 @@ class System:
                                        axis2=loop.get("axis2"), sequence=sequence,
                                        speeds=speeds)
         if loop or kind in ("distance", "coupling"):
+            if "child_position" in loop:
+                loop["child_position"] = flex.joint_point(
+                    self, element, child, "child_position", loop["child_position"])
             return add_loop_joint(self, name, kind, parent, child, axis=axis,
                                   position=position, orientation=orientation, **loop)
-        element = f"joint {name!r}"
         problem = label_problem(name)
         if problem:
             raise ModelError(f"joint name {name!r} {problem}")
@@ -338,13 +343,15 @@ class System:
         loads, forces, flex_loads, flex_forces = flex.split_elements(
             flexible, [ld for ld in self._loads.values() if state[ld.name]],
             [el for el in self._forces.values() if state[el.name]])
-        model = Model(self.name, flex.massless(bodies, flexible), joints, loads, gravity,
+        bodies, joints, at_nodes, nodes = attach_at_nodes(
+            self, flex.massless(bodies, flexible), joints, loop_joints, flexible)
+        model = Model(self.name, bodies, joints, loads, gravity,
                       warnings=found, parameters=self.parameters,
                       gravity_symbolic=self.gravity_symbolic if state["gravity"] else None,
-                      forces=forces, effects=state, loop_joints=loop_joints,
+                      forces=forces, effects=state, loop_joints=at_nodes,
                       controllers=[c for c in self._controllers.values()
                                    if any(state[a] for a in c.actuators)])
-        model = flex.flexible_model(model, flexible, state, flex_loads, flex_forces)
+        model = flex.flexible_model(model, flexible, state, flex_loads, flex_forces, nodes)
         if check_inertia and model.nu and not loop_joints:
             _check_inertia_of_every_dof(model)
         model.loops = {j.name: loop_bodies(self, j) for j in loop_joints}

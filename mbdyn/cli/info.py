@@ -102,7 +102,9 @@ def _route(model, method):
         return None
     text = (LOOP_ROUTES if model.has_loops else ROUTES).get(route, ROUTES.get(route))
     if getattr(model, "flexible_bodies", ()):
-        text = "M u' = f with the flexible bodies' modal terms, in Python (numpy)"
+        text = ("M u' = f + G^T lam, G u' = gamma with the flexible bodies' modal terms, "
+                "in Python (numpy)" if model.has_loops else
+                "M u' = f with the flexible bodies' modal terms, in Python (numpy)")
     return {"method": method, "route": route, "solves": text}
 
 

@@ -18,7 +18,11 @@ import numpy as np
 
 from ..algorithms import flexible_dynamics as flex
 from ..algorithms import flexible_forces
+from ..algorithms import flexible_loops as flex_loops
+from ..algorithms import flexible_newton_euler as flex_ne
+from ..algorithms import flexible_reactions as flex_reactions
 from ..errors import ModelError
+from .flexible_states import remapped_layout, state_map
 from .model import Model
 
 
@@ -76,7 +80,7 @@ def _not_yet(what):
 class FlexibleModel(Model):
     """A compiled model with flexible bodies; build it with ``System.compile()``."""
 
-    def __init__(self, tree, records, stiffening=True, loads=(), forces=()):
+    def __init__(self, tree, records, stiffening=True, loads=(), forces=(), nodes=()):
         # not Model.__init__: the tree is compiled already, and read through __getattr__
         self.tree = tree
         self.name = tree.name
@@ -84,13 +88,24 @@ class FlexibleModel(Model):
         self.flexible_bodies = tuple(r.name for r in records)
         self.flexible = {r.name: r for r in records}
         self._flex = pack_flexible(tree, records)
-        self.coordinates = tree.coordinates + sum((r.coordinates for r in records), ())
-        self.speeds = tree.speeds + sum((r.speeds for r in records), ())
+        #: the node frames joints attach to (``elements.flexible_nodes``), tree order
+        self.node_frames = tuple(nodes)
+        self._map = state_map(tree, self._flex, self.node_frames)
+        modal = sum((r.coordinates for r in records), ())
+        self._nux = tree.nu + len(modal)           # the extended speeds: tree's, modal
+        keep_q = range(tree.nq) if self._map is None else self._map.keep_q
+        keep_u = range(tree.nu) if self._map is None else self._map.keep_u
+        self.coordinates = tuple(tree.coordinates[k] for k in keep_q) + modal
+        self.speeds = (tuple(tree.speeds[k] for k in keep_u)
+                       + sum((r.speeds for r in records), ()))
         self.nq, self.nu = len(self.coordinates), len(self.speeds)
-        self.modal_coordinates = self.coordinates[tree.nq:]
-        #: the joint (or flexible body) of each speed
-        self._speed_joint = list(tree._speed_joint) + [r.name for r in records
-                                                       for _ in r.speeds]
+        self.modal_coordinates = modal
+        (self._quaternions, self._euler_middle, self._free_joint_slots,
+         self._speed_joint) = remapped_layout(tree, self._map, self._flex)
+        chain = {j for nf in self.node_frames for j in nf.joints}
+        self.joints = tuple(j for j in tree.joints if j not in chain)
+        bodies, joints, tree_loads = tree.elements
+        self.elements = (bodies, tuple(j for j in joints if j.name not in chain), tree_loads)
         self._coordinate_index = {c: k for k, c in enumerate(self.coordinates)}
         self._speed_index = {c: k for k, c in enumerate(self.speeds)}
         self._body = {**tree._body, **{r.name: r.rigid for r in records}}
@@ -98,11 +113,31 @@ class FlexibleModel(Model):
                             and self._body[f].has_inertia)
         self.tree_effect_example = f"flexibility_{records[0].name}"
         tree._full_workspace()        # the Jacobians and M the terms read
+        self._outer = None            # the model's state of an evaluation (load functions)
+        if self._map is not None:
+            _outer_load_functions(self)
         # loads and force elements at points of the flexible bodies: evaluated in Python
         self.loads = tree.loads + tuple(ld.name for ld in loads)
         self.forces = tree.forces + tuple(el.name for el in forces)
         self._force_elements = tree._force_elements + tuple(forces)
         self._flex_elements = flexible_forces.pack(self, loads, forces)
+
+    def _extended(self, q, u=None):
+        """``(q_x, u_x)``: the tree's state then the modal one (``compiled.
+        flexible_states``), from the model's ``(q, u)``; the same arrays without node
+        frames."""
+        self._outer = (q, np.zeros(self.nu) if u is None else u)
+        if self._map is None:
+            return q, u
+        return self._map.extended(q, u)
+
+    def _model_state(self, qx, ux):
+        """The model's ``(q, u)`` from extended ones."""
+        return (qx, ux) if self._map is None else self._map.model_state(qx, ux)
+
+    def _extended_speed(self, k):
+        """The extended index of the model's speed ``k``."""
+        return k if self._map is None else self._map.tree_index(k)
 
     def __getattr__(self, name):
         tree = self.__dict__.get("tree")
@@ -152,45 +187,73 @@ class FlexibleModel(Model):
 
     @property
     def has_loops(self):
-        return False
+        """True when loop joints close the tree (at points of flexible bodies or not)."""
+        return self.tree._con is not None
+
+    #: runs in Python project every fixed step onto the loops' constraints (the compiled
+    #: loops do so for rigid mechanisms)
+    projects_steps = True
+
+    def forward_dynamics(self, q, u, t=0.0, method="jourdain"):
+        """``u'``: of ``M u' = f``, or with loops of ``M u' = f + G^T lam``,
+        ``G u' = gamma`` (``algorithms.flexible_loops``); ``"newton-euler"`` (or
+        ``"-dense"``): the system with reaction unknowns (``algorithms.
+        flexible_newton_euler``)."""
+        if method in flex_ne.METHODS:
+            return flex_ne.forward_dynamics(self, q, u, t)
+        if self.has_loops:
+            self.formulation(method)
+            return flex_loops.constrained_accelerations(self, q, u, t)[0]
+        return flex.forward_dynamics(self, q, u, t, method)
 
     def formulation(self, method="auto"):
-        """``"jourdain"`` for ``"auto"`` and ``"jourdain"``; the other routes are refused."""
+        """``"jourdain"`` for ``"auto"`` and ``"jourdain"``, the Newton-Euler routes as
+        named; ``"articulated"`` is refused."""
         if method in ("auto", "jourdain"):
             return "jourdain"
+        if method in flex_ne.METHODS:
+            return method
         raise ModelError(f"model {self.name!r} has flexible bodies "
-                         f"({', '.join(self.flexible_bodies)}): only method 'jourdain' (or "
-                         f"'auto') is there for them, in Python; {method!r} is the next "
-                         "step")
+                         f"({', '.join(self.flexible_bodies)}): methods 'jourdain' (or "
+                         f"'auto'), 'newton-euler' and 'newton-euler-dense' are there for "
+                         f"them, in Python; not {method!r}")
 
-    # the tree's frames: their motion does not depend on the modal coordinates
-    def kinematics(self, q, u=None, ud=None, t=0.0):
+    # the tree's frames (the node frames among them, moved by the modal coordinates)
+    def _tree_state(self, q, u=None, ud=None):
+        q = np.asarray(q, float)
+        qx, ux = self._extended(q, None if u is None else np.asarray(u, float))
+        udx = None
+        if ud is not None:
+            udx = np.asarray(ud, float) if self._map is None else \
+                self._map.P @ np.asarray(ud, float)
         nqt, nut = self.tree.nq, self.tree.nu
-        return self.tree.kinematics(np.asarray(q, float)[:nqt],
-                                    None if u is None else np.asarray(u, float)[:nut],
-                                    None if ud is None else np.asarray(ud, float)[:nut], t)
+        return (qx[:nqt], None if ux is None else ux[:nut],
+                None if udx is None else udx[:nut])
 
-    def _padded(self, J):
-        out = np.zeros((3, self.nu))
+    def kinematics(self, q, u=None, ud=None, t=0.0):
+        return self.tree.kinematics(*self._tree_state(q, u, ud), t)
+
+    def _model_columns(self, J):
+        """A tree Jacobian (3, tree speeds) as columns of the model's speeds."""
+        out = np.zeros((3, self._nux))
         out[:, :J.shape[1]] = J
-        return out
+        return out if self._map is None else out @ self._map.P
 
     def jacobian_rotation(self, q, frame, t=0.0):
-        return self._padded(self.tree.jacobian_rotation(np.asarray(q, float)[:self.tree.nq],
-                                                        frame, t))
+        return self._model_columns(self.tree.jacobian_rotation(self._tree_state(q)[0],
+                                                               frame, t))
 
     def jacobian_translation(self, q, frame, point=None, t=0.0):
-        return self._padded(self.tree.jacobian_translation(
-            np.asarray(q, float)[:self.tree.nq], frame, point, t))
+        return self._model_columns(self.tree.jacobian_translation(
+            self._tree_state(q)[0], frame, point, t))
 
     def point_positions(self, q, points, t=0.0):
-        return self.tree.point_positions(np.asarray(q, float)[:self.tree.nq], points, t)
+        return self.tree.point_positions(self._tree_state(q)[0], points, t)
 
     def element_power(self, q, u, t=0.0):
         """The force elements' ``(V, P_nc, P_actuators)``, the flexible bodies' modal
         damping and geometric stiffening counted in ``P_nc`` (``modal_power``)."""
-        V, P_nc, P_act = self.tree.element_power(np.asarray(q, float)[:self.tree.nq],
-                                                 np.asarray(u, float)[:self.tree.nu], t)
+        V, P_nc, P_act = self.tree.element_power(*self._tree_state(q, u)[:2], t)
         V_f, P_f, _ = flex.element_energies(self, q, u, t)
         return V + V_f, P_nc + P_f + flex.modal_power(self, q, u, t), P_act
 
@@ -207,11 +270,9 @@ class FlexibleModel(Model):
         return V, P_nc + P_act
 
     def load_power(self, q, u, t=0.0):
-        return self.tree.load_power(np.asarray(q, float)[:self.tree.nq],
-                                    np.asarray(u, float)[:self.tree.nu], t) + \
+        return self.tree.load_power(*self._tree_state(q, u)[:2], t) + \
             flex.element_energies(self, q, u, t)[2]
 
-    forward_dynamics = flex.forward_dynamics
     state_derivative = flex.state_derivative
     coordinate_rates = flex.coordinate_rates
     mass_matrix = flex.mass_matrix
@@ -220,11 +281,37 @@ class FlexibleModel(Model):
     momentum = flex.momentum
     mass_matrix_condition = flex.mass_matrix_condition
     _check_at_rest = flex.check_at_rest
+    constraint_residuals = flex_loops.constraint_residuals
+    constraint_jacobian = flex_loops.constraint_jacobian
+    multipliers = flex_loops.multipliers
+    project = flex_loops.project
 
-    newton_euler = _not_yet("newton_euler")
-    reactions = _not_yet("reactions")
+    reactions = flex_reactions.reactions
+    reaction_uniqueness = flex_reactions.reaction_uniqueness
+
+    def reaction_array(self, q, u, t=0.0, frame="world"):
+        """The tree joints' reactions as one array, a row per joint of ``joints``."""
+        out = self.reactions(q, u, t, frame=frame)
+        return np.array([np.concatenate(out[name]) for name in self.joints])
+
+    newton_euler = flex_ne.newton_euler
     inverse_dynamics = _not_yet("inverse_dynamics")
     inverse_dynamics_along = _not_yet("inverse_dynamics_along")
-    drive_efforts = _not_yet("drive_efforts (the energy balance of a driven model)")
     lowlevel = _not_yet("the low-level compiled entry")
     loop_arguments = _not_yet("the compiled loops")
+
+
+def _outer_load_functions(model):
+    """The tree's loads given as Python functions ``(t, q, u)`` called with the model's
+    state (the tree's holds the node frames' chain coordinates, which the user's
+    function does not know); loads written as expressions read the tree's by name."""
+    tree = model.tree
+    given = {ld.name for ld in tree.elements[2]
+             if callable(ld.force) or callable(ld.moment)}
+
+    def outer(fn):
+        def load(t, q, u):
+            return fn(t, *model._outer)
+        return load
+    tree._load_functions = [(name, row, outer(fn) if name in given else fn)
+                            for name, row, fn in tree._load_functions]

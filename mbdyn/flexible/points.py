@@ -52,3 +52,26 @@ def node_position(reduced, name, where):
         return reduced.nodes[reduced.node(name)].astype(float)
     except ModelError as exc:
         raise ModelError(f"{where}: {exc}") from None
+
+
+#: the six components of a point's motion: displacement along x, y, z, then small
+#: rotation about x, y, z (body axes)
+COMPONENTS = ("ux", "uy", "uz", "rx", "ry", "rz")
+#: a component whose mode-shape entries all stay below this fraction of the largest of
+#: their kind (displacements, rotations) is taken as not moved by the modes: round-off
+#: of the reduction (a planar beam's out-of-plane entries) is not a motion
+NEGLIGIBLE = 1e-12
+
+
+def moved_components(point):
+    """The indices (into :data:`COMPONENTS`) of the components of ``point``'s motion that
+    its modes move: rows of ``[Phi_p; Psi_p]`` with an entry above :data:`NEGLIGIBLE`
+    times the largest entry of their kind (displacement or rotation)."""
+    out = []
+    for block, offset in ((point.Phi, 0), (point.Psi, 3)):
+        scale = float(np.abs(block).max(initial=0.0))
+        if scale == 0.0:
+            continue
+        out.extend(offset + k for k in range(3)
+                   if np.abs(block[k]).max() > NEGLIGIBLE * scale)
+    return tuple(out)

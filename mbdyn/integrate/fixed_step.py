@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ModelError, NonFiniteError, SingularMassMatrixError
+from ..errors import ModelError, NonFiniteError, SimulationError, SingularMassMatrixError
 from . import budget as budgets
 from .event_search import crossed_rows, event_rows, event_values
 from .events import EventRecord
@@ -142,12 +142,17 @@ def python_chunks(plan):
     """Yield ``(times, states, failure, None, rates)``, one step at a time, in Python
     (models with loads given as Python functions, or ``compiled_loop=False``)."""
     model, nq = plan.model, plan.model.nq
+    # closed loops through flexible bodies: every step projected, as the compiled loops
+    # project a rigid mechanism's (a rigid mechanism here keeps its unprojected steps)
+    project = getattr(model, "projects_steps", False) and model.has_loops
     t, y = plan.t0, plan.y0.copy()
     for h, ts in step_times(plan.t0, plan.t_end, plan.dt):
         for t_new in ts:
             try:
                 y_new, rate = fixed_step(plan.rhs, plan.integrator, t, y, h, nq)
-            except (NonFiniteError, SingularMassMatrixError) as exc:
+                if project:
+                    y_new[:nq], y_new[nq:] = model.project(y_new[:nq], y_new[nq:], t_new)
+            except (NonFiniteError, SingularMassMatrixError, SimulationError) as exc:
                 yield (np.empty(0), np.empty((0, y.size)), describe_failure(model, exc, t, y),
                        None, np.empty((0, y.size)))
                 return

@@ -54,7 +54,8 @@ def _modal_off(b, name, path):
     """True (with a warning) for a modal coordinate or speed of a flexible body whose
     flexibility the scene switched off: the body is rigid, its value is not used."""
     for body in b.system._flexible.values():
-        if name in body.coordinates + body.speeds:
+        if name in body.coordinates + body.speeds and \
+                body.coordinates[0] not in b.model.coordinates:
             warnings.warn(f"{'.'.join(map(str, path))}: body {body.name!r} is rigid in this "
                           "scene (flexibility_" f"{body.name} is off); {name} is ignored",
                           ModelWarning, stacklevel=4)

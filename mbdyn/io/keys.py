@@ -20,11 +20,11 @@ SHAPE_KEYS = {"type": ("choice", ("sphere", "box", "cylinder", "disk", "rod")),
 JOINT_KINDS = ("revolute", "prismatic", "euler", "spherical", "fixed", "free", "universal",
                "cylindrical", "distance", "coupling")
 JOINT_KEYS = {"name": "name", "kind": ("choice", JOINT_KINDS), "parent": "name",
-              "child": "name", "axis": "axis", "position": "vector",
+              "child": "name", "axis": "axis", "position": "place",
               "orientation": "orientation", "sequence": "string", "coordinates": "names",
               "speeds": "names", "drive": "expr",
               # loop joints (docs/constraints.md)
-              "child_position": "vector", "child_orientation": "orientation", "cut": "bool",
+              "child_position": "place", "child_orientation": "orientation", "cut": "bool",
               "axis2": "axis", "length": "expr", "follower": "name", "leader": "name",
               "ratio": "expr", "offset": "expr"}
 #: the keys that make a joint a loop joint

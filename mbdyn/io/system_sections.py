@@ -120,7 +120,7 @@ def add_joints(b):
                                   "the coordinate or the parameter")
         with b.engine(path):
             b.system.add_joint(name, kind, parent, child, axis=axis,
-                               position=b.pvector(j.get("position"), path + ("position",)),
+                               position=_place(b, j.get("position"), path + ("position",)),
                                orientation=orientation, sequence=j.get("sequence"),
                                coordinates=coordinates, speeds=speeds, drive=drive)
         _check_added_joint(b, b.system.joints[name], path)
@@ -153,7 +153,7 @@ def add_loop_joint(b, path, j, name, kind, loop):
         _check_frames(b, path, parent, child)
     for key in ("child_position",):
         if key in loop:
-            loop[key] = b.pvector(loop[key], path + (key,))
+            loop[key] = _place(b, loop[key], path + (key,))
     if "child_orientation" in loop:
         loop["child_orientation"] = _orientation(b, loop["child_orientation"],
                                                  path + ("child_orientation",))
@@ -169,7 +169,7 @@ def add_loop_joint(b, path, j, name, kind, loop):
         if key in j:
             raise b.error(path + (key,), f"a loop joint has no coordinates of its own: "
                           f"remove {key} (it belongs on a tree joint)")
-    position = b.pvector(j.get("position"), path + ("position",)) if "position" in j \
+    position = _place(b, j.get("position"), path + ("position",)) if "position" in j \
         else (0, 0, 0)
     orientation = _orientation(b, j.get("orientation"), path + ("orientation",))
     with b.engine(path):

@@ -23,9 +23,11 @@ COLOUR = "#3a7ca5"
 
 
 def _bodies(model):
-    """``[(record, pack)]`` of the model's flexible bodies whose flexibility is on."""
-    packs = {p.name: p for p in getattr(model, "_flex", ())}
-    return [(model.flexible[name], packs[name])
+    """``[(record, indices)]`` of the model's flexible bodies whose flexibility is on:
+    the record and its modal coordinates' indices in the model's ``q``."""
+    packs = {p.name for p in getattr(model, "_flex", ())}
+    return [(model.flexible[name], [model.coordinate_index(c)
+                                    for c in model.flexible[name].coordinates])
             for name in getattr(model, "flexible_bodies", ()) if name in packs]
 
 
@@ -33,19 +35,20 @@ def _length(nodes):
     return max(float(np.linalg.norm(nodes.max(axis=0) - nodes.min(axis=0))), 1e-9)
 
 
-def deflections(record, pack, q):
-    """Every node's elastic deflection ``Phi_i eta`` (N x 3, body axes) at the state ``q``."""
-    return record.reduced.modes[:, :3, :] @ np.asarray(q, float)[pack.q]
+def deflections(record, indices, q):
+    """Every node's elastic deflection ``Phi_i eta`` (N x 3, body axes) at the state ``q``
+    (``indices``: the body's modal coordinates in ``q``)."""
+    return record.reduced.modes[:, :3, :] @ np.asarray(q, float)[indices]
 
 
 def deflection_scale(model, states):
     """The factor the pictures draw deflections with, over the states ``states`` (rows
     of ``q``): 1.0 without flexible bodies or deflection."""
     largest, length = 0.0, np.inf
-    for rec, pack in _bodies(model):
+    for rec, indices in _bodies(model):
         length = min(length, _length(rec.reduced.nodes))
         for q in states:
-            largest = max(largest, float(np.abs(deflections(rec, pack, q)).max(initial=0.0)))
+            largest = max(largest, float(np.abs(deflections(rec, indices, q)).max(initial=0.0)))
     if not largest > 0.0 or not np.isfinite(length):
         return 1.0
     wanted = DRAWN * length / largest
@@ -77,10 +80,11 @@ def flexible_primitives(model, kin, q, scale=1.0):
     out = []
     if q is None:
         return out
-    for rec, pack in _bodies(model):
+    for rec, indices in _bodies(model):
         nodes = rec.reduced.nodes.astype(float)
-        R, r = kin.R[pack.frame], kin.r[pack.frame]
-        world = r + (nodes + scale * deflections(rec, pack, q)) @ R.T
+        i = model.frame_index(rec.name)
+        R, r = kin.R[i], kin.r[i]
+        world = r + (nodes + scale * deflections(rec, indices, q)) @ R.T
         radius = RADIUS * _length(nodes)
         if "beam" not in rec.spec:
             out += [("sphere", (np.eye(3), p), 2.0 * radius, COLOUR) for p in world]
