@@ -192,11 +192,12 @@ def test_runs_by_the_articulated_route():
 
 
 def test_min_norm_step_on_chosen_rows_equals_least_squares():
-    """A run's minimum-norm step (``loop_solve.min_norm_step``) equals numpy's least
+    """A run's minimum-norm step (``min_norm.min_norm_step``) equals numpy's least
     squares on 200 random consistent problems with redundant rows: first by the pivoted
     factorisation (which records its rows and their conditioning), then on the rows it
     chose; rows that lost their conditioning are chosen again."""
-    from mbdyn.kernels.loop_solve import ROWS, min_norm_step, min_norm_work
+    from mbdyn.kernels.loop_solve import ROWS
+    from mbdyn.kernels.min_norm import min_norm_step, min_norm_work
     rng = np.random.default_rng(11)
     for trial in range(200):
         nu, m = int(rng.integers(1, 9)), int(rng.integers(1, 16))
@@ -226,7 +227,7 @@ def test_min_norm_step_on_chosen_rows_equals_least_squares():
                                         ("models/four_bar.toml", "free")])
 def test_projection_steps_on_the_chosen_rows(path, case):
     """A run's projection takes its minimum-norm steps on the rows the last pivoted
-    factorisation chose (``loop_solve._min_norm_chosen``: ``r x r``, no pivoting) while they
+    factorisation chose (``min_norm._min_norm_chosen``: ``r x r``, no pivoting) while they
     keep their conditioning: the projected state equals the one the pivoted steps give (to
     rounding), the rows stay chosen; a zero row among them (as near a singular
     configuration) fails the conditioning test and the rows are chosen again."""

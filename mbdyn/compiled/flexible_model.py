@@ -190,10 +190,6 @@ class FlexibleModel(Model):
         """True when loop joints close the tree (at points of flexible bodies or not)."""
         return self.tree._con is not None
 
-    #: runs in Python project every fixed step onto the loops' constraints (the compiled
-    #: loops do so for rigid mechanisms)
-    projects_steps = True
-
     def forward_dynamics(self, q, u, t=0.0, method="jourdain"):
         """``u'``: of ``M u' = f``, or with loops of ``M u' = f + G^T lam``,
         ``G u' = gamma`` (``algorithms.flexible_loops``); ``"newton-euler"`` (or

@@ -142,9 +142,9 @@ def python_chunks(plan):
     """Yield ``(times, states, failure, None, rates)``, one step at a time, in Python
     (models with loads given as Python functions, or ``compiled_loop=False``)."""
     model, nq = plan.model, plan.model.nq
-    # closed loops through flexible bodies: every step projected, as the compiled loops
-    # project a rigid mechanism's (a rigid mechanism here keeps its unprojected steps)
-    project = getattr(model, "projects_steps", False) and model.has_loops
+    # a closed mechanism: every step projected onto the constraints, as the compiled
+    # loops do (docs/constraints.md)
+    project = model.has_loops
     t, y = plan.t0, plan.y0.copy()
     for h, ts in step_times(plan.t0, plan.t_end, plan.dt):
         for t_new in ts:

@@ -26,8 +26,9 @@ from .constraints import (DATA, POINT, ROW_WORK, _constraint_rows, constrained_j
 from .evaluate import jourdain_accelerations
 from .joints import coordinate_rates
 from .kinematics import walk
-from .loop_solve import (ROWS, augmented_solve, chosen_solve, constrained_solve,
-                         min_norm_step, rank_of, solve_work)
+from .loop_solve import (ROWS, augmented_solve, chosen_solve, constrained_solve, rank_of,
+                         solve_work)
+from .min_norm import min_norm_step
 from .packed import _scatter, _views
 from .views import UNCOUNTED, c_view, untracked
 
