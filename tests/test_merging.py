@@ -199,16 +199,20 @@ def test_the_frozen_calls_refuse_what_the_checked_route_converts_or_rejects():
     model = robot(loads=True).compile()
     q, u, ud = (np.round(x * 64) / 64 for x in state(model))   # exact in float32 too
     ref = (model.forward_dynamics(q, u), model.effort_array(q, u, ud), model.mass_matrix(q))
-    assert {"auto", "efforts", "mass matrix"} <= set(model._fast_calls)
+    close(model.forward_dynamics(q, u, method="jourdain"), ref[0], 1e-9)
+    assert {"auto", "jourdain", "efforts", "mass matrix"} <= set(model._fast_calls)
     read_only = q.copy()
     read_only.flags.writeable = False
     strided = np.repeat(q, 2)[::2]
     for qq in (list(q), q.astype(np.float32), read_only, strided):
         close(model.forward_dynamics(qq, list(u)), ref[0])
+        close(model.forward_dynamics(qq, u, method="jourdain"), ref[0], 1e-9)
         close(model.effort_array(qq, u, list(ud)), ref[1])
         close(model.mass_matrix(qq), ref[2])
     with pytest.raises(mb.ModelError, match="expects q of length"):
         model.forward_dynamics(q[:-1], u)
+    with pytest.raises(mb.ModelError, match="expects q of length"):
+        model.forward_dynamics(q, u[:-1], method="jourdain")
     with pytest.raises(mb.ModelError, match="u_dot needs"):
         model.effort_array(q, u, ud[:-1])
     with pytest.raises(mb.ModelError, match="expects q of length"):
@@ -217,5 +221,7 @@ def test_the_frozen_calls_refuse_what_the_checked_route_converts_or_rejects():
     bad[0] = np.nan
     with pytest.raises(mb.NonFiniteError):
         model.forward_dynamics(bad, u)
+    with pytest.raises(mb.NonFiniteError):
+        model.forward_dynamics(bad, u, method="jourdain")
     with pytest.raises(mb.NonFiniteError):
         model.effort_array(bad, u, ud)

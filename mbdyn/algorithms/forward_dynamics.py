@@ -38,9 +38,9 @@ def forward_dynamics(model, q, u, t=0.0, method="auto"):
     docs/performance.md)."""
     call = model._fast_calls.get(method)
     if call is not None:             # float64 arrays that fit: no check in Python (frozen)
-        kernel, fb, ib, table, forces, ud = call
+        kernel, fb, ib, forces, ud = call
         try:
-            if kernel(fb, ib, table, forces, q, u) == -1:
+            if kernel(fb, ib, forces, q, u) == -1:
                 return ud.copy()
         except (TypeError, ZeroDivisionError):
             pass                     # any other input, or a failure: the checked route
@@ -68,10 +68,10 @@ def _accelerations(model, q, u, t, method, key=None):
         if kernel is None:                       # its arrays not yet allocated
             model._full_workspace()
             kernel = model._jourdain_kernel
-        packed, ud = model._packed, model._ud
+        packed, ud = model._dynamics_full, model._ud          # (fb, ib, forces)
     else:                                        # on the merged tree (compiled.merging)
         kernel = kp.articulated_accelerations_packed
-        packed, ud = model._dynamics, model._dynamics_ud
+        packed, ud = model._dynamics, model._dynamics_ud    # (fb, ib, forces)
     status = None
     if not model._python_inputs and _plain(q, model.nq) and _plain(u, model.nu):
         try:

@@ -31,15 +31,16 @@ def mass_matrix(model, q, t=0.0):
     """The Jourdain mass matrix ``M(q)`` (nu x nu, symmetric), by composite rigid bodies
     in one compiled call (``kernels.inverse``: each joint's motion subspace, no full
     Jacobians, O(n depth)) on the merged tree (``compiled.merging``)."""
-    M = np.empty((model.nu, model.nu))
     call = model._fast_calls.get("mass matrix")
     if call is not None:             # a float64 array that fits: no check in Python (frozen)
-        kernel, fb, ib, table, forces = call
+        kernel, fb, ib, forces, shape = call
+        M = np.empty(shape)
         try:
-            if kernel(fb, ib, table, forces, q, M) == -1:
+            if kernel(fb, ib, forces, q, M) == -1:
                 return M
         except (TypeError, ZeroDivisionError):
             pass                     # any other input, or a failure: the checked route
+    M = np.empty((model.nu, model.nu))
     status = None
     if not model._python_inputs and _plain(q, model.nq):
         try:                                 # a float64 array as it comes: no conversion
@@ -60,7 +61,8 @@ def mass_matrix(model, q, t=0.0):
         raise NonFiniteError(f"model {model.name!r}, t={t:.6g}: the mass matrix came out "
                              "non-finite (check masses, inertias and drives)")
     if not model._python_inputs:
-        _freeze(model, "mass matrix", ki.mass_matrix_packed, model._dynamics, (q, M))
+        _freeze(model, "mass matrix", ki.mass_matrix_packed, model._dynamics, (q, M),
+                M.shape)
     return M
 
 
@@ -97,7 +99,7 @@ def jourdain_packed(model, q, u, t):
     if model._python_inputs:
         model._fill_inputs(q, u, t)
     try:
-        kp.jourdain_accelerations_packed(*model._packed, q, u)
+        kp.jourdain_accelerations_packed(*model._dynamics_full, q, u)
     except ZeroDivisionError:
         raise model._division_by_zero(q, t) from None
     return q, u

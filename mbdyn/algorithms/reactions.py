@@ -104,10 +104,10 @@ def effort_array(model, q, u, u_dot, t=0.0):
     ``M u' - f`` of its tree)."""
     call = model._fast_calls.get("efforts")
     if call is not None:             # float64 arrays that fit: no check in Python (frozen)
-        kernel, fb, ib, table, forces = call
-        tau = np.empty(model.nu)
+        kernel, fb, ib, forces, nu = call
+        tau = np.empty(nu)
         try:
-            if kernel(fb, ib, table, forces, q, u, u_dot, tau) == -1:
+            if kernel(fb, ib, forces, q, u, u_dot, tau) == -1:
                 return tau
         except (TypeError, ZeroDivisionError):
             pass                     # any other input, or a failure: the checked route
@@ -116,9 +116,9 @@ def effort_array(model, q, u, u_dot, t=0.0):
 
 def _efforts(model, packed, q, u, u_dot, t, key=None):
     """``effort_array`` on the packed tree ``packed``: the merged one, or the full one
-    (``model._packed``), whose joint wrenches ``model._W`` then holds.  After a call that
-    succeeded, a model without inputs written in Python calls the kernel ``frozen`` from
-    then on, under ``key`` (``inputs.freeze``)."""
+    (``model._dynamics_full``), whose joint wrenches ``model._W`` then holds.  After a
+    call that succeeded, a model without inputs written in Python calls the kernel
+    ``frozen`` from then on, under ``key`` (``inputs.freeze``)."""
     tau = np.empty(model.nu)
     status = None
     if (model._con is None and not model._python_inputs and _plain(q, model.nq)
@@ -143,7 +143,7 @@ def _efforts(model, packed, q, u, u_dot, t, key=None):
         model._check_finite(q, u, t, tau, "the inverse dynamics")
     if key is not None and not model._python_inputs and model._con is None:
         _freeze(model, key, ki.inverse_dynamics_packed, packed,
-                (q, u, np.require(u_dot, float, "CW"), tau))
+                (q, u, np.require(u_dot, float, "CW"), tau), model.nu)
     return tau
 
 
@@ -156,7 +156,7 @@ def inverse_dynamics(model, q, u, u_dot, t=0.0, frame="world"):
     ``effort_array`` gives the efforts alone as an array, faster."""
     if frame not in ("world", "child"):
         raise ModelError(f"unknown frame {frame!r} for reactions; use 'world' or 'child'")
-    Q = _efforts(model, model._packed, q, u, u_dot, t)     # the full tree: every joint
+    Q = _efforts(model, model._dynamics_full, q, u, u_dot, t)   # the full tree: every joint
     if model._con is None:
         w = model._W                     # the joint wrenches of that motion
     else:
@@ -201,7 +201,7 @@ def inverse_dynamics_along(model, t, q, u, u_dot=None, frame="world"):
         return efforts, reactions
     wrenches = np.empty((len(t), model.n_frames, 6))
     for k in range(len(t)):              # one compiled call a sample, no dictionaries
-        efforts[k] = _efforts(model, model._packed, q[k], u[k], u_dot[k], t[k])
+        efforts[k] = _efforts(model, model._dynamics_full, q[k], u[k], u_dot[k], t[k])
         wrenches[k] = model._W
     for i, j in enumerate(model.joints):
         reactions[j][:] = wrenches[:, i]

@@ -259,8 +259,9 @@ def pack(model, loop_joints=0):
 
     The merged tree of the per-call dynamics (``compiled.merging``: rigidly attached
     frames merged into their carriers) is laid out with them: ``model._dynamics`` holds
-    its packed arguments ``(fbuf, ibuf, table, forces)`` and ``model._dynamics_ud`` its
-    ``u'``; without one (nothing to merge), the full tree's."""
+    its packed arguments ``(fbuf, ibuf, forces)`` for the per-call entries (articulated
+    bodies, inverse dynamics, mass matrix) and ``model._dynamics_ud`` its ``u'``; without
+    one (nothing to merge), the full tree's (``model._dynamics_full``)."""
     attr = {name: "gravity" if name == "gravity" else "_" + name
             for name in kp.FLOATS + kp.INTS + kp.FAR}
     merged = merging.plan(model, loop_joints)
@@ -278,10 +279,13 @@ def pack(model, loop_joints=0):
     forces = ((model._force_int, model._force_shapes) if model._force_int.shape[0]
               else None)
     model._packed = (fbuf, ibuf, table, forces)
-    model._dynamics, model._dynamics_ud = model._packed, model._ud
+    # the per-call entries' arguments (the integer buffer stands for its table): the full
+    # tree's, and the merged tree's
+    model._dynamics_full = (fbuf, ibuf, forces)
+    model._dynamics, model._dynamics_ud = model._dynamics_full, model._ud
     model._merged_frames = 0
     if merged is not None:
-        model._dynamics = (fbuf, ibuf2, ibuf2[:table.shape[0]],
+        model._dynamics = (fbuf, ibuf2,
                            None if forces is None else (views2["force_int"], forces[1]))
         model._dynamics_ud = views2["ud"]
         model._merged_frames = model.n_frames - merged["n"]

@@ -43,8 +43,13 @@ def _jourdain_state(fb, ib, y, ydot):
     return _state(kp.state_derivative_packed, fb, ib, y, ydot)
 
 
+@njit(inline="always", **UNCOUNTED)
+def _articulated_derivative(fb, ib, t, forces, y, ydot):
+    return kp.state_derivative_articulated_packed(fb, ib, forces, y, ydot)
+
+
 def _articulated_state(fb, ib, y, ydot):
-    return _state(kp.state_derivative_articulated_packed, fb, ib, y, ydot)
+    return _state(_articulated_derivative, fb, ib, y, ydot)
 
 
 def _tree_reactions(fb, ib, q, u, out):

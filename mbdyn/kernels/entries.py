@@ -71,7 +71,7 @@ def inverse_dynamics(fb, ib, q, u, ud, tau):
     nu = ib[1]
     if q.shape[0] != ib[7] or u.shape[0] != nu or ud.shape[0] != nu or tau.shape[0] != nu:
         return WRONG_SIZE
-    return ki.inverse_dynamics_packed(fb, ib, ib, kp.force_table(ib, ib), q, u, ud, tau)
+    return ki.inverse_dynamics_packed(fb, ib, kp.force_table(ib, ib), q, u, ud, tau)
 
 
 def mass_matrix(fb, ib, q, M):
@@ -79,7 +79,7 @@ def mass_matrix(fb, ib, q, M):
     nu = ib[1]
     if q.shape[0] != ib[7] or M.shape[0] != nu or M.shape[1] != nu:
         return WRONG_SIZE
-    return ki.mass_matrix_packed(fb, ib, ib, None, q, M)
+    return ki.mass_matrix_packed(fb, ib, None, q, M)
 
 
 @njit(inline="always", **UNCOUNTED)
@@ -96,11 +96,24 @@ def _forward(accelerations, fb, ib, q, u, out):
     return status
 
 
+@njit(inline="always", **UNCOUNTED)
+def _articulated(fb, ib, t, forces, q, u):
+    """``packed.articulated_accelerations_packed`` in ``_forward``'s arguments (the table
+    is the integer buffer's head)."""
+    return kp.articulated_accelerations_packed(fb, ib, forces, q, u)
+
+
+@njit(inline="always", **UNCOUNTED)
+def _jourdain(fb, ib, t, forces, q, u):
+    """``packed.jourdain_accelerations_packed`` in ``_forward``'s arguments."""
+    return kp.jourdain_accelerations_packed(fb, ib, forces, q, u)
+
+
 def jourdain_forward(fb, ib, q, u, out):
     """Forward dynamics ``u'`` into ``out`` by ``M u' = f`` (Cholesky)."""
-    return _forward(kp.jourdain_accelerations_packed, fb, ib, q, u, out)
+    return _forward(_jourdain, fb, ib, q, u, out)
 
 
 def articulated_forward(fb, ib, q, u, out):
     """Forward dynamics ``u'`` into ``out`` by the articulated-body algorithm."""
-    return _forward(kp.articulated_accelerations_packed, fb, ib, q, u, out)
+    return _forward(_articulated, fb, ib, q, u, out)

@@ -27,7 +27,8 @@ of them held anywhere, stay as they are.
 import numpy as np
 from numba import njit
 
-from .evaluate import (articulated_accelerations, jourdain_accelerations, newton_euler_solution,
+from .articulated import articulated_body
+from .evaluate import (jourdain_accelerations, motion_and_loads, newton_euler_solution,
                        newton_euler_tree)
 from .forces import ROW
 from .joints import coordinate_rates
@@ -254,10 +255,12 @@ def _scatter(fb, ib, t, q, u):
 
 
 @njit(**UNCOUNTED)
-def jourdain_accelerations_packed(fb, ib, t, forces, q, u):
+def jourdain_accelerations_packed(fb, ib, forces, q, u):
     """Scatter ``q``, ``u``, then ``evaluate.jourdain_accelerations`` on packed arrays (same
     return value, or ``WRONG_SIZE`` for ``q`` or ``u`` of another size; ``u'`` is left in
-    the ``ud`` view)."""
+    the ``ud`` view).  The integer buffer stands for the offset table, as in
+    ``articulated_accelerations_packed``."""
+    t = ib
     if q.shape[0] != t[7] or u.shape[0] != t[1]:
         return WRONG_SIZE
     _scatter(fb, ib, t, q, u)
@@ -311,27 +314,42 @@ def newton_euler_solution_packed(fb, ib, t, forces, q, u, A, b):
 
 
 @njit(**UNCOUNTED)
-def articulated_accelerations_packed(fb, ib, t, forces, q, u):
-    """Scatter ``q``, ``u``, then ``evaluate.articulated_accelerations`` on packed arrays
-    (same return value, or ``WRONG_SIZE`` for ``q`` or ``u`` of another size; ``u'`` is
-    left in the ``ud`` view)."""
+def articulated_accelerations_packed(fb, ib, forces, q, u):
+    """Scatter ``q``, ``u``, then ``evaluate.articulated_accelerations`` on packed arrays,
+    its kinematics by ``motion`` (``evaluate.motion_and_loads``): the same return value,
+    or ``WRONG_SIZE`` for ``q`` or ``u`` of another size; ``u'`` is left in the ``ud``
+    view.  The integer buffer stands for the offset table (its head, ``pack``): an
+    argument less for numba to check at each call from Python."""
+    t = ib
     if q.shape[0] != t[7] or u.shape[0] != t[1]:
         return WRONG_SIZE
     _scatter(fb, ib, t, q, u)
-    tree, body, state, loads, _, motion, jourdain, art, scratch = _views(fb, ib, t, forces)
+    tree, body, state, loads, _, kin, jourdain, art, scratch = _views(fb, ib, t, forces)
     mass, com, inertia, _, gravity = body
-    return articulated_accelerations(tree[:9] + art[:2], (mass, com, inertia, gravity), state,
-                                     loads, motion, art[2:8], jourdain[3], scratch)
+    motion_and_loads(tree, body, state, loads, kin, scratch)
+    parent, kind, ucol = tree[0], tree[1], tree[8]
+    R, r, w, v, alpha, a, _, _, S, F, N = kin
+    IA, pA, cb, U, Dl, acc = art[2:8]
+    ud = jourdain[3]
+    pivot = articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha, a, S, F,
+                             N, IA, pA, cb, U, Dl, acc, ud, scratch)
+    if pivot >= 0:
+        return pivot
+    for k in range(ud.shape[0]):
+        if not np.isfinite(ud[k]):
+            return -2
+    return -1
 
 
 @njit(**UNCOUNTED)
-def state_derivative_articulated_packed(fb, ib, t, forces, y, ydot):
-    """``state_derivative_packed`` with ``u'`` by the articulated-body algorithm."""
-    nq = t[7]
-    pivot = articulated_accelerations_packed(fb, ib, t, forces, y[:nq], y[nq:])
+def state_derivative_articulated_packed(fb, ib, forces, y, ydot):
+    """``state_derivative_packed`` with ``u'`` by the articulated-body algorithm (the
+    integer buffer standing for the table, as ``articulated_accelerations_packed``)."""
+    nq = ib[7]
+    pivot = articulated_accelerations_packed(fb, ib, forces, y[:nq], y[nq:])
     if pivot >= 0:
         return pivot
-    return _state_rates(fb, ib, t, y, ydot)
+    return _state_rates(fb, ib, ib, y, ydot)
 
 
 @njit(**UNCOUNTED)
