@@ -279,7 +279,7 @@ def kernel_cases(loop, tree, q, u, loops, count=200):
         from mbdyn.algorithms.constrained import groups
         ref_tree = tree.forward_dynamics(q, u)
         ref_loop = loop.forward_dynamics(q, u)
-        targs = (*tree._packed, np.array(q, float), np.array(u, float))
+        targs = (*tree._dynamics_full, np.array(q, float), np.array(u, float))
         tree_loop(1, *targs)
         loop._fill(q, u, 0.0)
         largs = (*groups(loop), loop._con, loop._scratch)

@@ -202,17 +202,17 @@ def measure(cases, budget, repeats, ratios=()):
 # ----------------------------------------------------------------------------- raw kernels
 def packed_args(model, q, u):
     """The arguments ``Model.forward_dynamics`` passes to the packed Jourdain kernel: the
-    float buffer, the integer buffer, the offset table, the force table or None
+    float buffer, the integer buffer (its head the offset table), the force table or None
     (``mbdyn.kernels.packed``), q, u."""
-    return (*model._packed, np.asarray(q, float), np.asarray(u, float))
+    return (*model._dynamics_full, np.asarray(q, float), np.asarray(u, float))
 
 
 _PACKED = {}
 
 
 def packed_helpers(kernel):
-    """``nop(fb, ib, t, forces, q, u)``: zeroes the packed ``ud`` and returns -1 at once (its
-    call cost is numba's dispatch for the six arguments); ``loop(count, fb, ib, t, forces,
+    """``nop(fb, ib, forces, q, u)``: zeroes the packed ``ud`` and returns -1 at once (its
+    call cost is numba's dispatch for the five arguments); ``loop(count, fb, ib, forces,
     q, u)``:
     calls ``kernel`` ``count`` times from compiled code (its compute time without
     dispatch)."""
@@ -222,16 +222,16 @@ def packed_helpers(kernel):
         UD = kp.UD
 
         @njit
-        def nop(fb, ib, t, forces, q, u):
-            fb[t[UD]:t[UD] + t[1]] = 0.0
+        def nop(fb, ib, forces, q, u):
+            fb[ib[UD]:ib[UD] + ib[1]] = 0.0
             return -1
 
         loop = None
         if kernel is not None:
             @njit
-            def loop(count, fb, ib, t, forces, q, u):
+            def loop(count, fb, ib, forces, q, u):
                 for _ in range(count):
-                    kernel(fb, ib, t, forces, q, u)   # writes its outputs: not elided
+                    kernel(fb, ib, forces, q, u)      # writes its outputs: not elided
                 return count
         _PACKED[kernel] = (nop, loop)
     return _PACKED[kernel]
@@ -312,7 +312,7 @@ class Raw:
             self.jargs = packed_args(model, q, u)
             self.ud = model._ud
             self.prebuilt = True
-            self.neargs = tuple(self.jargs) + tuple(model._dense_system())
+            self.neargs = (*model._packed, *self.jargs[-2:]) + tuple(model._dense_system())
             self.jk = kp.jourdain_accelerations_packed
             self.nek = kp.newton_euler_solution_packed
             ref = model.forward_dynamics(q, u, 0.0, method="jourdain")

@@ -10,6 +10,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..kernels import packed as kp
+from .inputs import freeze as _freeze
 from .inputs import plain as _plain
 from .constrained import loop_route
 from .loop_newton_euler import loop_newton_euler
@@ -35,34 +36,46 @@ def forward_dynamics(model, q, u, t=0.0, method="auto"):
     solved by LU (``"newton-euler-dense"``).  All four solve the same equations;
     ``"auto"`` (the default) takes the fastest at the model's size (``formulation``,
     docs/performance.md)."""
+    call = model._fast_calls.get(method)
+    if call is not None:             # float64 arrays that fit: no check in Python (frozen)
+        kernel, fb, ib, forces, ud = call
+        try:
+            if kernel(fb, ib, forces, q, u) == -1:
+                return ud.copy()
+        except (TypeError, ZeroDivisionError):
+            pass                     # any other input, or a failure: the checked route
     if model._con is not None and method in ("auto", "jourdain", "articulated"):
         # closed loops: G u' = gamma, by the mass matrix or the articulated bodies
         return model._constrained_accelerations(q, u, t, loop_route(model, method))
-    if method == "auto":
-        method = model._auto_route
-    if model._con is not None and method in ("newton-euler", "newton-euler-dense"):
+    route = model._auto_route if method == "auto" else method
+    if model._con is not None and route in ("newton-euler", "newton-euler-dense"):
         return loop_newton_euler(model, q, u, t)[0]
-    if method in ("jourdain", "articulated"):
-        return _accelerations(model, q, u, t, method)
+    if route in ("jourdain", "articulated"):
+        return _accelerations(model, q, u, t, route, method)
+    method = route
     if method in ("newton-euler", "newton-euler-dense"):
         return model._newton_euler(q, u, t, dense=method == "newton-euler-dense")[:model.nu]
     raise ModelError(f"unknown method {method!r}; use one of {', '.join(METHODS)}")
 
 
-def _accelerations(model, q, u, t, method):
+def _accelerations(model, q, u, t, method, key=None):
     """``u'`` by one packed kernel into a new array: float64 arrays as they come, anything
-    else converted and checked first."""
+    else converted and checked first.  After a call that succeeded, a model without
+    inputs written in Python calls the kernel ``frozen`` from then on (``_fast_calls``
+    under the ``method`` asked for, ``key``), unchecked: numba refuses any other type."""
     if method == "jourdain":
         kernel = model._jourdain_kernel
         if kernel is None:                       # its arrays not yet allocated
             model._full_workspace()
             kernel = model._jourdain_kernel
-    else:
+        packed, ud = model._dynamics_full, model._ud          # (fb, ib, forces)
+    else:                                        # on the merged tree (compiled.merging)
         kernel = kp.articulated_accelerations_packed
+        packed, ud = model._dynamics, model._dynamics_ud    # (fb, ib, forces)
     status = None
     if not model._python_inputs and _plain(q, model.nq) and _plain(u, model.nu):
         try:
-            status = kernel(*model._packed, q, u)
+            status = kernel(*packed, q, u)
         except ZeroDivisionError:
             pass
     if status is None:                           # convert, check, say what is wrong
@@ -71,14 +84,16 @@ def _accelerations(model, q, u, t, method):
         if model._python_inputs:
             model._fill_inputs(q, u, t)
         try:
-            status = kernel(*model._packed, q, u)
+            status = kernel(*packed, q, u)
         except ZeroDivisionError:
             raise model._division_by_zero(q, t) from None
     if status >= 0:
         model._raise_singular(q, t, status)
     if status == -2:
-        model._check_finite(q, u, t, model._ud, "the accelerations")
-    return model._ud.copy()
+        model._check_finite(q, u, t, ud, "the accelerations")
+    if key is not None and not model._python_inputs:
+        _freeze(model, key, kernel, packed, (q, u), ud)
+    return ud.copy()
 
 
 def formulation(model, method="auto"):
@@ -123,7 +138,7 @@ def state_derivative(model, t, y, method="auto"):
         if kernel is None:
             model._full_workspace()
             kernel = model._jourdain_rates
-    elif method == "articulated":
+    elif method == "articulated":               # on the merged tree (compiled.merging)
         kernel = kp.state_derivative_articulated_packed
     else:
         raise ModelError(f"state_derivative: unknown method {method!r}; use 'jourdain' "
@@ -131,8 +146,9 @@ def state_derivative(model, t, y, method="auto"):
     if model._python_inputs:
         model._fill_inputs(y[:model.nq], y[model.nq:], t)
     ydot = np.empty(model.nq + model.nu)
+    packed = model._dynamics if method == "articulated" else model._packed
     try:
-        status = kernel(*model._packed, y, ydot)
+        status = kernel(*packed, y, ydot)
     except ZeroDivisionError:
         raise model._division_by_zero(y[:model.nq], t) from None
     if status >= 0:

@@ -10,6 +10,7 @@ import numpy as np
 
 from ..errors import ModelError, NonFiniteError, SingularMassMatrixError
 from ..kernels import forces as kf
+from ..kernels.entries import frozen
 
 
 def fill(model, q, u, t):
@@ -54,6 +55,17 @@ def plain(x, n):
     ``n`` entries, C-contiguous and writable (anything else is converted first)."""
     return (type(x) is np.ndarray and x.dtype == np.float64 and x.shape == (n,)
             and x.flags.c_contiguous and x.flags.writeable)
+
+
+def freeze(model, key, kernel, packed, args, *rest):
+    """After a checked call of ``kernel`` on ``(*packed, *args)`` succeeded: enter
+    ``(kernel frozen for these types, *packed, *rest)`` into the model's fast calls under
+    ``key`` (``kernels.entries.frozen``), when it can be had.  The ordinary per-call
+    methods then call it first, with no check in Python: numba refuses any other type,
+    the kernel any other size."""
+    call = frozen(kernel, (*packed, *args))
+    if call is not None:
+        model._fast_calls[key] = (call, *packed, *rest)
 
 
 def state(model, q, u):

@@ -12,6 +12,7 @@ from ..errors import NonFiniteError
 from ..kernels import dynamics as kd
 from ..kernels import inverse as ki
 from .inputs import plain as _plain
+from .inputs import freeze as _freeze
 from ..kernels import packed as kp
 
 
@@ -29,12 +30,21 @@ def jourdain_terms(model, q, u, t):
 def mass_matrix(model, q, t=0.0):
     """The Jourdain mass matrix ``M(q)`` (nu x nu, symmetric), by composite rigid bodies
     in one compiled call (``kernels.inverse``: each joint's motion subspace, no full
-    Jacobians, O(n depth))."""
+    Jacobians, O(n depth)) on the merged tree (``compiled.merging``)."""
+    call = model._fast_calls.get("mass matrix")
+    if call is not None:             # a float64 array that fits: no check in Python (frozen)
+        kernel, fb, ib, forces, shape = call
+        M = np.empty(shape)
+        try:
+            if kernel(fb, ib, forces, q, M) == -1:
+                return M
+        except (TypeError, ZeroDivisionError):
+            pass                     # any other input, or a failure: the checked route
     M = np.empty((model.nu, model.nu))
     status = None
     if not model._python_inputs and _plain(q, model.nq):
         try:                                 # a float64 array as it comes: no conversion
-            status = ki.mass_matrix_packed(*model._packed, q, M)
+            status = ki.mass_matrix_packed(*model._dynamics, q, M)
         except ZeroDivisionError:
             pass
     u = np.zeros(model.nu)
@@ -43,13 +53,16 @@ def mass_matrix(model, q, t=0.0):
         if model._python_inputs:             # the drives' coordinates at t
             model._fill_inputs(q, u, t)
         try:
-            status = ki.mass_matrix_packed(*model._packed, q, M)
+            status = ki.mass_matrix_packed(*model._dynamics, q, M)
         except ZeroDivisionError:
             raise model._division_by_zero(q, t) from None
     if status == -2:
         model._require_finite(q, u, t)
         raise NonFiniteError(f"model {model.name!r}, t={t:.6g}: the mass matrix came out "
                              "non-finite (check masses, inertias and drives)")
+    if not model._python_inputs:
+        _freeze(model, "mass matrix", ki.mass_matrix_packed, model._dynamics, (q, M),
+                M.shape)
     return M
 
 
@@ -86,7 +99,7 @@ def jourdain_packed(model, q, u, t):
     if model._python_inputs:
         model._fill_inputs(q, u, t)
     try:
-        kp.jourdain_accelerations_packed(*model._packed, q, u)
+        kp.jourdain_accelerations_packed(*model._dynamics_full, q, u)
     except ZeroDivisionError:
         raise model._division_by_zero(q, t) from None
     return q, u

@@ -12,6 +12,7 @@ from ..kernels import dynamics as kd
 from ..kernels import inverse as ki
 from .inputs import plain as _plain
 from .forward_dynamics import ARTICULATED_FROM, METHODS
+from .inputs import freeze as _freeze
 from .loop_newton_euler import loop_newton_euler_reactions
 from .newton_euler import tree_order
 from .loop_reactions import child_rotation, loop_reactions
@@ -99,13 +100,31 @@ def effort_array(model, q, u, u_dot, t=0.0):
     motion ``(q, u, u')``: ``Q = M u' - f``, one array in ``Model.speeds`` order (a torque
     on a revolute joint's speed, a force on a prismatic one) -- ``inverse_dynamics``'s
     efforts without its dictionaries, by the recursive Newton-Euler algorithm in one
-    compiled call (O(n); a closed mechanism by ``M u' - f`` of its tree)."""
+    compiled call on the merged tree (O(n), ``compiled.merging``; a closed mechanism by
+    ``M u' - f`` of its tree)."""
+    call = model._fast_calls.get("efforts")
+    if call is not None:             # float64 arrays that fit: no check in Python (frozen)
+        kernel, fb, ib, forces, nu = call
+        tau = np.empty(nu)
+        try:
+            if kernel(fb, ib, forces, q, u, u_dot, tau) == -1:
+                return tau
+        except (TypeError, ZeroDivisionError):
+            pass                     # any other input, or a failure: the checked route
+    return _efforts(model, model._dynamics, q, u, u_dot, t, "efforts")
+
+
+def _efforts(model, packed, q, u, u_dot, t, key=None):
+    """``effort_array`` on the packed tree ``packed``: the merged one, or the full one
+    (``model._dynamics_full``), whose joint wrenches ``model._W`` then holds.  After a
+    call that succeeded, a model without inputs written in Python calls the kernel
+    ``frozen`` from then on, under ``key`` (``inputs.freeze``)."""
     tau = np.empty(model.nu)
     status = None
     if (model._con is None and not model._python_inputs and _plain(q, model.nq)
             and _plain(u, model.nu) and _plain(u_dot, model.nu)):
         try:                             # float64 arrays as they come: no conversion
-            status = ki.inverse_dynamics_packed(*model._packed, q, u, u_dot, tau)
+            status = ki.inverse_dynamics_packed(*packed, q, u, u_dot, tau)
         except ZeroDivisionError:
             pass
     if status is None:                   # convert, check, say what is wrong
@@ -117,11 +136,14 @@ def effort_array(model, q, u, u_dot, t=0.0):
         if model._python_inputs:
             model._fill_inputs(q, u, t)
         try:
-            status = ki.inverse_dynamics_packed(*model._packed, q, u, ud, tau)
+            status = ki.inverse_dynamics_packed(*packed, q, u, ud, tau)
         except ZeroDivisionError:
             raise model._division_by_zero(q, t) from None
     if status == -2:
         model._check_finite(q, u, t, tau, "the inverse dynamics")
+    if key is not None and not model._python_inputs and model._con is None:
+        _freeze(model, key, ki.inverse_dynamics_packed, packed,
+                (q, u, np.require(u_dot, float, "CW"), tau), model.nu)
     return tau
 
 
@@ -134,7 +156,7 @@ def inverse_dynamics(model, q, u, u_dot, t=0.0, frame="world"):
     ``effort_array`` gives the efforts alone as an array, faster."""
     if frame not in ("world", "child"):
         raise ModelError(f"unknown frame {frame!r} for reactions; use 'world' or 'child'")
-    Q = effort_array(model, q, u, u_dot, t)
+    Q = _efforts(model, model._dynamics_full, q, u, u_dot, t)   # the full tree: every joint
     if model._con is None:
         w = model._W                     # the joint wrenches of that motion
     else:
@@ -179,7 +201,7 @@ def inverse_dynamics_along(model, t, q, u, u_dot=None, frame="world"):
         return efforts, reactions
     wrenches = np.empty((len(t), model.n_frames, 6))
     for k in range(len(t)):              # one compiled call a sample, no dictionaries
-        efforts[k] = effort_array(model, q[k], u[k], u_dot[k], t[k])
+        efforts[k] = _efforts(model, model._dynamics_full, q[k], u[k], u_dot[k], t[k])
         wrenches[k] = model._W
     for i, j in enumerate(model.joints):
         reactions[j][:] = wrenches[:, i]

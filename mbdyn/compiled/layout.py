@@ -22,6 +22,7 @@ from ..kernels.contact import CONTACT_SHAPES
 from ..elements.joints import make_drive
 from ..elements.values import t as TIME
 from .constraint_packing import pack_constraints
+from . import merging
 
 #: the clock: a drive whose value is the time
 CLOCK = make_drive(TIME, "the clock")
@@ -250,17 +251,24 @@ def workspace(model, joints, loop_joints=0):
     model._slots = np.array(model._free_joint_slots, np.int64).reshape(-1, 5)
 
 
-def pack(model):
+def pack(model, loop_joints=0):
     """Move every array the fused kernels use into two flat buffers (``kernels.packed``):
     the attributes become views of them, and a kernel call passes three arrays instead of
     38.  The (empty) arrays of ``full_workspace`` stay where they are, entered in the
-    offset table by address."""
+    offset table by address.
+
+    The merged tree of the per-call dynamics (``compiled.merging``: rigidly attached
+    frames merged into their carriers) is laid out with them: ``model._dynamics`` holds
+    its packed arguments ``(fbuf, ibuf, forces)`` for the per-call entries (articulated
+    bodies, inverse dynamics, mass matrix) and ``model._dynamics_ud`` its ``u'``; without
+    one (nothing to merge), the full tree's (``model._dynamics_full``)."""
     attr = {name: "gravity" if name == "gravity" else "_" + name
             for name in kp.FLOATS + kp.INTS + kp.FAR}
-    fbuf, ibuf, table, views = kp.pack(
+    merged = merging.plan(model, loop_joints)
+    fbuf, ibuf, table, views, ibuf2, views2 = kp.pack(
         {k: getattr(model, attr[k]) for k in kp.FLOATS},
         {k: getattr(model, attr[k]) for k in kp.INTS},
-        {k: getattr(model, attr[k]) for k in kp.FAR})
+        {k: getattr(model, attr[k]) for k in kp.FAR}, merged)
     for name, view in views.items():
         setattr(model, attr[name], view)
     # the force elements as the kernels take them (kernels.packed): None without any, so
@@ -271,6 +279,16 @@ def pack(model):
     forces = ((model._force_int, model._force_shapes) if model._force_int.shape[0]
               else None)
     model._packed = (fbuf, ibuf, table, forces)
+    # the per-call entries' arguments (the integer buffer stands for its table): the full
+    # tree's, and the merged tree's
+    model._dynamics_full = (fbuf, ibuf, forces)
+    model._dynamics, model._dynamics_ud = model._dynamics_full, model._ud
+    model._merged_frames = 0
+    if merged is not None:
+        model._dynamics = (fbuf, ibuf2,
+                           None if forces is None else (views2["force_int"], forces[1]))
+        model._dynamics_ud = views2["ud"]
+        model._merged_frames = model.n_frames - merged["n"]
 
 
 def full_workspace(model):

@@ -43,8 +43,13 @@ def _jourdain_state(fb, ib, y, ydot):
     return _state(kp.state_derivative_packed, fb, ib, y, ydot)
 
 
+@njit(inline="always", **UNCOUNTED)
+def _articulated_derivative(fb, ib, t, forces, y, ydot):
+    return kp.state_derivative_articulated_packed(fb, ib, forces, y, ydot)
+
+
 def _articulated_state(fb, ib, y, ydot):
-    return _state(kp.state_derivative_articulated_packed, fb, ib, y, ydot)
+    return _state(_articulated_derivative, fb, ib, y, ydot)
 
 
 def _tree_reactions(fb, ib, q, u, out):
@@ -84,8 +89,13 @@ class LowLevel:
         if method == "jourdain":
             model._full_workspace()
         self._fd, self._sd = (_entry(f, sig) for f, sig in zip(ROUTES[method], SIGNATURES))
-        self._fb, self._ib = model._packed[:2]
-        self._ud = model._ud
+        # the full tree's buffers (the reactions, the Jourdain route), the merged tree's
+        # integer buffer (the articulated bodies, inverse dynamics, the mass matrix:
+        # compiled.merging); the float buffer is the same
+        self._fb, self._ib_full = model._packed[:2]
+        self._ib_merged = model._dynamics[1]
+        self._ib, self._ud = ((self._ib_full, model._ud) if method == "jourdain"
+                              else (self._ib_merged, model._dynamics_ud))
         self._inputs = model._python_inputs
         self._nq, self._nu = model.nq, model.nu
         self._ydot = np.empty(model.nq + model.nu)
@@ -152,8 +162,8 @@ class LowLevel:
         if out is None:
             out = self._wrenches
         try:
-            status = _entry(_tree_reactions, REACTIONS_SIGNATURE)(self._fb, self._ib, q, u,
-                                                                   out)
+            status = _entry(_tree_reactions, REACTIONS_SIGNATURE)(self._fb, self._ib_full,
+                                                                   q, u, out)
         except TypeError:
             status = WRONG_SIZE
         if status != -1:
@@ -179,7 +189,7 @@ class LowLevel:
             out = self._tau
         try:
             status = _entry(entries.inverse_dynamics, entries.INVERSE_SIGNATURE)(
-                self._fb, self._ib, q, u, u_dot, out)
+                self._fb, self._ib_merged, q, u, u_dot, out)
         except TypeError:
             status = WRONG_SIZE
         if status != -1:
@@ -198,7 +208,7 @@ class LowLevel:
             out = self._M
         try:
             status = _entry(entries.mass_matrix, entries.MASS_MATRIX_SIGNATURE)(
-                self._fb, self._ib, q, out)
+                self._fb, self._ib_merged, q, out)
         except TypeError:
             status = WRONG_SIZE
         if status != -1:

@@ -71,7 +71,7 @@ class Model:
         #: the Jourdain route's packed kernels (forward dynamics, state derivative): set
         #: with the arrays they read, on first use (layout.full_workspace)
         self._jourdain_kernel = self._jourdain_rates = None
-        layout.pack(self)
+        layout.pack(self, len(loop_joints))
         #: (load name, the row of the load array its function fills, the function)
         self._load_functions = [(name, getattr(self, target)[k], fn)
                                 for name, target, k, fn in load_functions]
@@ -80,6 +80,9 @@ class Model:
         #: drives, function loads or force laws: values Python writes before each compiled
         #: evaluation
         self._python_inputs = bool(self._time_inputs or self._load_functions or self._laws)
+        #: the per-call entries' kernels frozen to their one specialization, with their
+        #: packed arguments, by method (``kernels.entries.frozen``): filled on first use
+        self._fast_calls = {}
         #: controllers in Python and PID integral terms, updated at their sampling
         #: instants between compiled stretches (``integrate.sampled``)
         self._controllers = tuple(controllers)

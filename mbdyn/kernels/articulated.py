@@ -34,7 +34,9 @@ import math
 from numba import njit
 
 from .joints import EULER, NU, REVOLUTE, SPHERICAL
-from .views import UNCOUNTED, c_view
+from .motion import cross, row3
+from .spatial import body_inertia, mirror, rigid_upper, shift_upper
+from .views import FUSED, UNCOUNTED, c_view
 
 #: floats of scratch ``articulated_body`` needs: ``ARTICULATED_WORK + 6 n`` for n frames
 #: (``joint_wrenches_tree`` needs 6)
@@ -165,7 +167,88 @@ def _add_shifted_translational_inertia(IA, i, p, rho, T):
             IA[p, 3 + a_, 3 + b_] += IA[i, 3 + a_, 3 + b_]
 
 
-@njit(**UNCOUNTED)
+@njit(**FUSED)
+def _bodies(mass, com, inertia, parent, R, r, w, alpha_b, a_b, F, N, IA, pA, cb):
+    """The first sweep of ``articulated_body``: every body on its own -- the upper
+    triangle of its spatial inertia (``spatial``), its bias force (velocity products and
+    applied loads) and its joint's bias acceleration ``c_i = A_bias_i - X A_bias_p``."""
+    for i in range(mass.shape[0]):
+        c, Iw = body_inertia(R, com, inertia, i)
+        m_i = mass[i]
+        rigid_upper(IA, i, m_i, c, Iw)
+        wi = row3(w, i)
+        t1 = cross(wi, cross(wi, c))     # w x (w x c), the centre of mass relative to O_i
+        f = (m_i * t1[0] - F[i, 0], m_i * t1[1] - F[i, 1], m_i * t1[2] - F[i, 2])
+        # about O_i: w x Iw w - N + c x (m w x (w x c) - F)
+        t2 = cross(wi, (Iw[0] * wi[0] + Iw[1] * wi[1] + Iw[2] * wi[2],
+                        Iw[1] * wi[0] + Iw[3] * wi[1] + Iw[4] * wi[2],
+                        Iw[2] * wi[0] + Iw[4] * wi[1] + Iw[5] * wi[2]))
+        t3 = cross(c, f)
+        for a_ in range(3):
+            pA[i, a_] = t2[a_] - N[i, a_] + t3[a_]
+            pA[i, 3 + a_] = f[a_]
+        p = parent[i]
+        if p >= 0:
+            ap = row3(alpha_b, p)
+            t4 = cross(ap, (r[i, 0] - r[p, 0], r[i, 1] - r[p, 1], r[i, 2] - r[p, 2]))
+            for a_ in range(3):
+                cb[i, a_] = alpha_b[i, a_] - ap[a_]
+                cb[i, 3 + a_] = a_b[i, a_] - a_b[p, a_] - t4[a_]
+        else:
+            for a_ in range(3):
+                cb[i, a_] = alpha_b[i, a_]
+                cb[i, 3 + a_] = a_b[i, a_]
+
+
+@njit(**FUSED)
+def _one_speed(IA, pA, cb, U, Dl, S, i, turns):
+    """The joint of frame ``i`` with one speed (motion subspace ``s``, ``S[i, :, 0]``; no
+    translation part when it ``turns``), the upper triangle of its articulated inertia
+    complete: ``U = IA s``, ``D = s^T U`` (its square root in ``Dl[i, 0, 0]``),
+    ``z = -s^T pA / D`` in ``Dl[i, 0, 6]``; then ``IA[i]`` becomes ``Ia = IA - U U^T / D``
+    (whole) and ``pA[i]`` ``pa = pA + Ia c + U z``.  Returns ``D`` (not positive: no
+    inertia on this speed, nothing written after it)."""
+    s0, s1, s2 = S[i, 0, 0], S[i, 1, 0], S[i, 2, 0]
+    # U = IA s from the upper triangle (IA[b, a] = IA[a, b])
+    u0 = IA[i, 0, 0] * s0 + IA[i, 0, 1] * s1 + IA[i, 0, 2] * s2
+    u1 = IA[i, 0, 1] * s0 + IA[i, 1, 1] * s1 + IA[i, 1, 2] * s2
+    u2 = IA[i, 0, 2] * s0 + IA[i, 1, 2] * s1 + IA[i, 2, 2] * s2
+    u3 = IA[i, 0, 3] * s0 + IA[i, 1, 3] * s1 + IA[i, 2, 3] * s2
+    u4 = IA[i, 0, 4] * s0 + IA[i, 1, 4] * s1 + IA[i, 2, 4] * s2
+    u5 = IA[i, 0, 5] * s0 + IA[i, 1, 5] * s1 + IA[i, 2, 5] * s2
+    D = s0 * u0 + s1 * u1 + s2 * u2
+    sb = -(s0 * pA[i, 0] + s1 * pA[i, 1] + s2 * pA[i, 2])
+    if not turns:
+        s3, s4, s5 = S[i, 3, 0], S[i, 4, 0], S[i, 5, 0]
+        u0 += IA[i, 0, 3] * s3 + IA[i, 0, 4] * s4 + IA[i, 0, 5] * s5
+        u1 += IA[i, 1, 3] * s3 + IA[i, 1, 4] * s4 + IA[i, 1, 5] * s5
+        u2 += IA[i, 2, 3] * s3 + IA[i, 2, 4] * s4 + IA[i, 2, 5] * s5
+        u3 += IA[i, 3, 3] * s3 + IA[i, 3, 4] * s4 + IA[i, 3, 5] * s5
+        u4 += IA[i, 3, 4] * s3 + IA[i, 4, 4] * s4 + IA[i, 4, 5] * s5
+        u5 += IA[i, 3, 5] * s3 + IA[i, 4, 5] * s4 + IA[i, 5, 5] * s5
+        D = s0 * u0 + s1 * u1 + s2 * u2 + s3 * u3 + s4 * u4 + s5 * u5
+        sb -= s3 * pA[i, 3] + s4 * pA[i, 4] + s5 * pA[i, 5]
+    if not D > 0.0:
+        return D
+    Dl[i, 0, 0] = math.sqrt(D)
+    z = sb / D
+    Dl[i, 0, 6] = z
+    u = (u0, u1, u2, u3, u4, u5)
+    g = 1.0 / D
+    for a_ in range(6):
+        U[i, a_, 0] = u[a_]
+        ga = u[a_] * g
+        for b_ in range(a_, 6):
+            IA[i, a_, b_] -= ga * u[b_]
+            IA[i, b_, a_] = IA[i, a_, b_]
+    for a_ in range(6):
+        pA[i, a_] += (IA[i, a_, 0] * cb[i, 0] + IA[i, a_, 1] * cb[i, 1] + IA[i, a_, 2] * cb[i, 2]
+                      + IA[i, a_, 3] * cb[i, 3] + IA[i, a_, 4] * cb[i, 4]
+                      + IA[i, a_, 5] * cb[i, 5] + u[a_] * z)
+    return D
+
+
+@njit(**FUSED)
 def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a_b, S, F, N,
                      IA, pA, cb, U, Dl, acc, ud, work):
     """Forward dynamics ``ud`` by the articulated-body algorithm (see the module
@@ -185,58 +268,15 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
     of freedom without inertia).  ``work``: ``ARTICULATED_WORK + 6 n`` floats of scratch
     (the last ``6 n``: each joint's ``1 / L_jj``, so that its solves multiply).
     """
-    # long: the articulated-body algorithm's three sweeps over the tree (bias accelerations,
-    # leaves to root, root to leaves) fused so each frame's rows stay in the scratch; its
-    # helpers, inlined, made the first compile slower (issue 23) and not inlined cost a call
-    # per frame.
+    # long: the articulated-body algorithm's sweeps over the tree (bodies, leaves to root,
+    # root to leaves); a joint of one speed by ``_one_speed``, the others written out here
+    # on the whole 6x6 blocks (the leaves-to-root sweep adds only upper triangles,
+    # ``spatial``, and a frame's block is made whole before it is read).
     n = mass.shape[0]
     Iw, Y, Vbig = c_view(work, 0, (3, 3)), c_view(work, 9, (6, 3)), c_view(work, 51, (6, 6))
     inv = c_view(work, ARTICULATED_WORK, (n, 6))
-    c, wc, t1, t2 = (c_view(work, 27, (3,)), c_view(work, 30, (3,)), c_view(work, 33, (3,)),
-                     c_view(work, 36, (3,)))
-    rho, v6, wv = c_view(work, 39, (3,)), c_view(work, 42, (6,)), c_view(work, 48, (3,))
-    # -- every body on its own: spatial inertia, velocity-product and applied wrench
-    for i in range(n):
-        world_inertia(R, com, inertia, i, c, Iw, Y)
-        m_i = mass[i]
-        _spatial_inertia(m_i, c, Iw, IA, i)
-        wi = wv
-        for a_ in range(3):
-            wi[a_] = w[i, a_]
-        # w x (w x c): centripetal acceleration of the centre of mass relative to O_i
-        wc[0] = wi[1] * c[2] - wi[2] * c[1]
-        wc[1] = wi[2] * c[0] - wi[0] * c[2]
-        wc[2] = wi[0] * c[1] - wi[1] * c[0]
-        t1[0] = wi[1] * wc[2] - wi[2] * wc[1]
-        t1[1] = wi[2] * wc[0] - wi[0] * wc[2]
-        t1[2] = wi[0] * wc[1] - wi[1] * wc[0]
-        for a_ in range(3):              # force part: m w x (w x c) - F
-            pA[i, 3 + a_] = m_i * t1[a_] - F[i, a_]
-        # moment part about O_i: w x Iw w + c x m w x (w x c) - N - c x F
-        for a_ in range(3):
-            t2[a_] = Iw[a_, 0] * wi[0] + Iw[a_, 1] * wi[1] + Iw[a_, 2] * wi[2]
-        pA[i, 0] = wi[1] * t2[2] - wi[2] * t2[1] - N[i, 0]
-        pA[i, 1] = wi[2] * t2[0] - wi[0] * t2[2] - N[i, 1]
-        pA[i, 2] = wi[0] * t2[1] - wi[1] * t2[0] - N[i, 2]
-        pA[i, 0] += c[1] * pA[i, 5] - c[2] * pA[i, 4]
-        pA[i, 1] += c[2] * pA[i, 3] - c[0] * pA[i, 5]
-        pA[i, 2] += c[0] * pA[i, 4] - c[1] * pA[i, 3]
-        # the joint's bias acceleration c_i = A_bias_i - X A_bias_p
-        p = parent[i]
-        if p >= 0:
-            for a_ in range(3):
-                rho[a_] = r[i, a_] - r[p, a_]
-            ap0, ap1, ap2 = alpha_b[p, 0], alpha_b[p, 1], alpha_b[p, 2]
-            cb[i, 0] = alpha_b[i, 0] - ap0
-            cb[i, 1] = alpha_b[i, 1] - ap1
-            cb[i, 2] = alpha_b[i, 2] - ap2
-            cb[i, 3] = a_b[i, 0] - a_b[p, 0] - (ap1 * rho[2] - ap2 * rho[1])
-            cb[i, 4] = a_b[i, 1] - a_b[p, 1] - (ap2 * rho[0] - ap0 * rho[2])
-            cb[i, 5] = a_b[i, 2] - a_b[p, 2] - (ap0 * rho[1] - ap1 * rho[0])
-        else:
-            for a_ in range(3):
-                cb[i, a_] = alpha_b[i, a_]
-                cb[i, 3 + a_] = a_b[i, a_]
+    rho, v6 = c_view(work, 39, (3,)), c_view(work, 42, (6,))
+    _bodies(mass, com, inertia, parent, R, r, w, alpha_b, a_b, F, N, IA, pA, cb)
     # -- leaves to root: articulated inertias and biases
     largest = 0.0
     for i in range(n - 1, -1, -1):
@@ -244,11 +284,19 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
         kd = kind[i]
         k = NU[kd] if col0 >= 0 else 0
         ball = k > 0 and kd == SPHERICAL
-        if k:
+        if k == 1:
+            D = _one_speed(IA, pA, cb, U, Dl, S, i, kd == REVOLUTE)
+            if not D > 0.0:
+                return col0
+            largest = max(largest, D)
+            inv[i, 0] = 1.0 / Dl[i, 0, 0]
+        else:
+            mirror(IA, i)
+        if k > 1:
             # U = IA S, D = S^T U, and D's Cholesky factor in Dl[i, :k, :k].  A joint that
-            # only turns about the frame's origin (revolute, Euler angles, spherical) has
-            # zero translation columns: their terms, which come last, are skipped.
-            turns = kd == REVOLUTE or kd == EULER or kd == SPHERICAL
+            # only turns about the frame's origin (Euler angles, spherical) has zero
+            # translation columns: their terms, which come last, are skipped.
+            turns = kd == EULER or kd == SPHERICAL
             for j in range(k):
                 s0, s1, s2 = S[i, 0, j], S[i, 1, j], S[i, 2, j]
                 for a_ in range(6):
@@ -310,7 +358,7 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
                     for j in range(k):
                         s += U[i, a_, j] * Dl[i, j, 6]
                     pA[i, a_] += s
-        if not ball:
+        if k != 1 and not ball:
             for a_ in range(6):
                 s = 0.0
                 for b_ in range(6):
@@ -318,16 +366,16 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
                 pA[i, a_] += s
         p = parent[i]
         if p >= 0:
-            for a_ in range(3):
-                rho[a_] = r[i, a_] - r[p, a_]
+            x, y, z = r[i, 0] - r[p, 0], r[i, 1] - r[p, 1], r[i, 2] - r[p, 2]
             if ball:
+                rho[0], rho[1], rho[2] = x, y, z
                 _add_shifted_translational_inertia(IA, i, p, rho, Iw)     # Iw: 3x3 scratch
             else:
-                _add_shifted_inertia(IA, i, p, rho, Y)
+                shift_upper(IA, i, p, x, y, z)
             f0, f1, f2 = pA[i, 3], pA[i, 4], pA[i, 5]
-            pA[p, 0] += pA[i, 0] + rho[1] * f2 - rho[2] * f1
-            pA[p, 1] += pA[i, 1] + rho[2] * f0 - rho[0] * f2
-            pA[p, 2] += pA[i, 2] + rho[0] * f1 - rho[1] * f0
+            pA[p, 0] += pA[i, 0] + y * f2 - z * f1
+            pA[p, 1] += pA[i, 1] + z * f0 - x * f2
+            pA[p, 2] += pA[i, 2] + x * f1 - y * f0
             pA[p, 3] += f0
             pA[p, 4] += f1
             pA[p, 5] += f2
@@ -342,32 +390,41 @@ def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a
     for i in range(n):
         p = parent[i]
         if p >= 0:
-            for a_ in range(3):
-                rho[a_] = r[i, a_] - r[p, a_]
-            acc[i, 0] = acc[p, 0] + cb[i, 0]
-            acc[i, 1] = acc[p, 1] + cb[i, 1]
-            acc[i, 2] = acc[p, 2] + cb[i, 2]
-            acc[i, 3] = acc[p, 3] + acc[p, 1] * rho[2] - acc[p, 2] * rho[1] + cb[i, 3]
-            acc[i, 4] = acc[p, 4] + acc[p, 2] * rho[0] - acc[p, 0] * rho[2] + cb[i, 4]
-            acc[i, 5] = acc[p, 5] + acc[p, 0] * rho[1] - acc[p, 1] * rho[0] + cb[i, 5]
+            x, y, z = r[i, 0] - r[p, 0], r[i, 1] - r[p, 1], r[i, 2] - r[p, 2]
+            a0, a1, a2 = acc[p, 0], acc[p, 1], acc[p, 2]
+            acc[i, 0] = a0 + cb[i, 0]
+            acc[i, 1] = a1 + cb[i, 1]
+            acc[i, 2] = a2 + cb[i, 2]
+            acc[i, 3] = acc[p, 3] + a1 * z - a2 * y + cb[i, 3]
+            acc[i, 4] = acc[p, 4] + a2 * x - a0 * z + cb[i, 4]
+            acc[i, 5] = acc[p, 5] + a0 * y - a1 * x + cb[i, 5]
         else:
             for a_ in range(6):
                 acc[i, a_] = cb[i, a_]
         col0 = ucol[i]
-        if col0 >= 0:
-            k = NU[kind[i]]
-            # u' = D^-1 (-S^T pA) - D^-1 U^T (X A_p + c)
-            for j in range(k):
-                s = 0.0
-                for a_ in range(6):
-                    s += U[i, a_, j] * acc[i, a_]
-                v6[j] = s
-            _cholesky_solve_small(Dl, inv, i, k, v6)
-            for j in range(k):
-                udj = Dl[i, j, 6] - v6[j]
-                ud[col0 + j] = udj
-                for a_ in range(6):
-                    acc[i, a_] += S[i, a_, j] * udj
+        if col0 < 0:
+            continue
+        k = NU[kind[i]]
+        if k == 1:
+            s = (U[i, 0, 0] * acc[i, 0] + U[i, 1, 0] * acc[i, 1] + U[i, 2, 0] * acc[i, 2]
+                 + U[i, 3, 0] * acc[i, 3] + U[i, 4, 0] * acc[i, 4] + U[i, 5, 0] * acc[i, 5])
+            udj = Dl[i, 0, 6] - s * inv[i, 0] * inv[i, 0]
+            ud[col0] = udj
+            for a_ in range(6):
+                acc[i, a_] += S[i, a_, 0] * udj
+            continue
+        # u' = D^-1 (-S^T pA) - D^-1 U^T (X A_p + c)
+        for j in range(k):
+            s = 0.0
+            for a_ in range(6):
+                s += U[i, a_, j] * acc[i, a_]
+            v6[j] = s
+        _cholesky_solve_small(Dl, inv, i, k, v6)
+        for j in range(k):
+            udj = Dl[i, j, 6] - v6[j]
+            ud[col0 + j] = udj
+            for a_ in range(6):
+                acc[i, a_] += S[i, a_, j] * udj
     return -1
 
 

@@ -14,14 +14,14 @@ one array less to type and unbox at every call; the force table is its view
 ``Model`` methods call the packed kernels themselves, with ``None`` for a model without
 force elements (a first call compiles less).
 """
-from numba import njit
+from numba import njit, typeof
 
 from . import inverse as ki
 from . import packed as kp
 from .views import UNCOUNTED, c_view
 
 #: a size that does not fit the model
-WRONG_SIZE = -3
+WRONG_SIZE = kp.WRONG_SIZE
 
 #: ``(fb, ib, q, u, out)``
 FORWARD_SIGNATURE = "int64(float64[::1], int64[::1], float64[::1], float64[::1], float64[::1])"
@@ -32,6 +32,7 @@ INVERSE_SIGNATURE = ("int64(float64[::1], int64[::1], float64[::1], float64[::1]
 MASS_MATRIX_SIGNATURE = "int64(float64[::1], int64[::1], float64[::1], float64[:, ::1])"
 
 _COMPILED = {}
+_FROZEN = {}
 
 
 def entry(function, signature):
@@ -42,13 +43,35 @@ def entry(function, signature):
     return _COMPILED[function]
 
 
+def frozen(kernel, args):
+    """``kernel`` (a compiled dispatcher) restricted to the specialization it already has
+    for the types of ``args``: a dispatcher that never compiles, so that an argument of
+    any other type (a list, another dtype, a non-contiguous or read-only array) raises
+    ``TypeError`` in numba's own dispatch, at no cost to a call that fits -- the ordinary
+    ``Model`` methods call it before any check of their own, and check (and convert)
+    only when it refuses.  Made once per kernel and types, from the compiled code (no
+    compile); ``None`` when ``kernel`` has no such specialization."""
+    types = tuple(typeof(a) for a in args)
+    key = (kernel, types)
+    if key not in _FROZEN:
+        compiled = kernel.overloads.get(types)
+        if compiled is None:
+            return None
+        options = {k: v for k, v in kernel.targetoptions.items() if k != "nopython"}
+        clone = njit(**options)(kernel.py_func)
+        clone.add_overload(compiled)
+        clone.disable_compile()
+        _FROZEN[key] = clone
+    return _FROZEN[key]
+
+
 def inverse_dynamics(fb, ib, q, u, ud, tau):
     """Generalized forces ``tau = M u' - f`` on the free speeds, and the joint wrenches in
     the packed ``W`` view (``inverse.inverse_dynamics_packed``)."""
     nu = ib[1]
     if q.shape[0] != ib[7] or u.shape[0] != nu or ud.shape[0] != nu or tau.shape[0] != nu:
         return WRONG_SIZE
-    return ki.inverse_dynamics_packed(fb, ib, ib, kp.force_table(ib, ib), q, u, ud, tau)
+    return ki.inverse_dynamics_packed(fb, ib, kp.force_table(ib, ib), q, u, ud, tau)
 
 
 def mass_matrix(fb, ib, q, M):
@@ -56,7 +79,7 @@ def mass_matrix(fb, ib, q, M):
     nu = ib[1]
     if q.shape[0] != ib[7] or M.shape[0] != nu or M.shape[1] != nu:
         return WRONG_SIZE
-    return ki.mass_matrix_packed(fb, ib, ib, None, q, M)
+    return ki.mass_matrix_packed(fb, ib, None, q, M)
 
 
 @njit(inline="always", **UNCOUNTED)
@@ -73,11 +96,24 @@ def _forward(accelerations, fb, ib, q, u, out):
     return status
 
 
+@njit(inline="always", **UNCOUNTED)
+def _articulated(fb, ib, t, forces, q, u):
+    """``packed.articulated_accelerations_packed`` in ``_forward``'s arguments (the table
+    is the integer buffer's head)."""
+    return kp.articulated_accelerations_packed(fb, ib, forces, q, u)
+
+
+@njit(inline="always", **UNCOUNTED)
+def _jourdain(fb, ib, t, forces, q, u):
+    """``packed.jourdain_accelerations_packed`` in ``_forward``'s arguments."""
+    return kp.jourdain_accelerations_packed(fb, ib, forces, q, u)
+
+
 def jourdain_forward(fb, ib, q, u, out):
     """Forward dynamics ``u'`` into ``out`` by ``M u' = f`` (Cholesky)."""
-    return _forward(kp.jourdain_accelerations_packed, fb, ib, q, u, out)
+    return _forward(_jourdain, fb, ib, q, u, out)
 
 
 def articulated_forward(fb, ib, q, u, out):
     """Forward dynamics ``u'`` into ``out`` by the articulated-body algorithm."""
-    return _forward(kp.articulated_accelerations_packed, fb, ib, q, u, out)
+    return _forward(_articulated, fb, ib, q, u, out)

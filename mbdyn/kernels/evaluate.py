@@ -15,6 +15,7 @@ from .dynamics import (applied_loads, cholesky_solve, jourdain_terms, jourdain_w
                        newton_euler_system)
 from .forces import FORCE_WORK, force_elements
 from .kinematics import KINEMATICS_WORK, walk
+from .motion import MOTION_WORK, motion
 from .views import UNCOUNTED, c_view
 
 
@@ -48,6 +49,52 @@ def kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_
         if force_int.shape[0]:
             force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w,
                            v, F, N, force_data[0:0], scratch, shapes)
+
+
+@njit(**UNCOUNTED)
+def loads_at(parent, axis, mass, com, gravity, qfull, ufull, load_body, load_point,
+             load_force, load_moment, load_in_body, forces, force_data, R, r, w, v, F, N,
+             scratch):
+    """The applied loads ``F``, ``N`` of the motion in ``R .. v``: gravity, point loads and
+    the force elements (``forces``: None, or the force table and its shapes' flag, an
+    argument of its own so that numba prunes the force kernel for None)."""
+    applied_loads(mass, com, gravity, R, r, load_body, load_point, load_force, load_moment,
+                  load_in_body, F, N, scratch)
+    if forces is not None:
+        force_int, shapes = forces
+        if force_int.shape[0]:
+            force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w,
+                           v, F, N, force_data[0:0], scratch, shapes)
+
+
+@njit(**UNCOUNTED)
+def motion_and_loads(tree, body, state, loads, kin, scratch):
+    """``kinematics_and_loads`` for the per-call entries, with the kinematics of
+    ``motion.motion`` (no full Jacobians; ``S``) and, with the gyroscopic effect switched
+    off, the motion again with every speed zero after the loads (as
+    ``drop_velocity_products``).  The groups as ``articulated_accelerations``'s (``tree``:
+    its first nine arrays)."""
+    parent, kind, axis, seq, pos, C, qoff, uoff = tree[:8]
+    mass, com, gravity = body[0], body[1], body[4]
+    qfull, ufull, udfull = state
+    (load_body, load_point, load_force, load_moment, load_in_body, forces, force_data,
+     switches) = loads
+    R, r, w, v, alpha, a, _, _, S, F, N = kin
+    motion(parent, kind, axis, seq, pos, C, qoff, uoff, qfull, ufull, udfull, R, r, w, v,
+           alpha, a, S, scratch, 1)
+    loads_at(parent, axis, mass, com, gravity, qfull, ufull, load_body, load_point,
+             load_force, load_moment, load_in_body, forces, force_data, R, r, w, v, F, N,
+             scratch)
+    if switches[0] == 0:
+        nuf = ufull.shape[0]
+        saved = c_view(scratch, MOTION_WORK, (nuf,))
+        for k in range(nuf):
+            saved[k] = ufull[k]
+            ufull[k] = 0.0
+        motion(parent, kind, axis, seq, pos, C, qoff, uoff, qfull, ufull, udfull, R, r, w,
+               v, alpha, a, S, scratch, 1)
+        for k in range(nuf):
+            ufull[k] = saved[k]
 
 
 @njit(inline="always", **UNCOUNTED)

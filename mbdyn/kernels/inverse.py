@@ -17,18 +17,18 @@ from numba import njit
 
 import numpy as np
 
-from .articulated import _add_shifted_inertia, _spatial_inertia, world_inertia
-from .evaluate import drop_velocity_products, kinematics_and_loads
+from .evaluate import motion_and_loads
 from .joints import NU
-from .kinematics import walk
-from .packed import FREE_Q, FREE_U, UDFULL, UFULL, _scatter, _views
-from .views import UNCOUNTED, c_view
+from .motion import cross, motion, row3
+from .packed import FREE_Q, FREE_U, UDFULL, WRONG_SIZE, _scatter, _views
+from .spatial import body_inertia
+from .views import FUSED, UNCOUNTED
 
 #: floats of scratch the two kernels need
 INVERSE_WORK = 48
 
 
-@njit(**UNCOUNTED)
+@njit(**FUSED)
 def recursive_newton_euler(mass, com, inertia, parent, kind, ucol, R, r, w, alpha, a, S, F, N,
                            wrench, tau, work):
     """Inverse dynamics from the leaves to the root.  ``alpha``, ``a``: each frame's angular
@@ -36,31 +36,27 @@ def recursive_newton_euler(mass, com, inertia, parent, kind, ucol, R, r, w, alph
     ``F``, ``N``: the applied force and the moment about the centre of mass.  Writes
     ``wrench[i] = (force, moment)``, what the parent exerts on the child about ``O_i``
     (world components), and ``tau`` (free speeds): ``S_k`` of the speed's own joint
-    dotted with that wrench.  ``work``: ``INVERSE_WORK`` floats."""
+    dotted with that wrench.  ``work``: ``INVERSE_WORK`` floats (not read: the frame's
+    quantities are local tuples, ``spatial``)."""
     n = mass.shape[0]
-    Iw, Y = c_view(work, 0, (3, 3)), c_view(work, 9, (3, 3))
-    c, aG, t1, t2 = (c_view(work, 18, (3,)), c_view(work, 21, (3,)), c_view(work, 24, (3,)),
-                     c_view(work, 27, (3,)))
     for i in range(n):               # each body's own wrench: m aG - F, about O_i
-        world_inertia(R, com, inertia, i, c, Iw, Y)
-        w0, w1, w2 = w[i, 0], w[i, 1], w[i, 2]
-        al0, al1, al2 = alpha[i, 0], alpha[i, 1], alpha[i, 2]
-        # aG = a + alpha x c + w x (w x c)
-        t1[0], t1[1], t1[2] = w1 * c[2] - w2 * c[1], w2 * c[0] - w0 * c[2], w0 * c[1] - w1 * c[0]
-        aG[0] = a[i, 0] + al1 * c[2] - al2 * c[1] + w1 * t1[2] - w2 * t1[1]
-        aG[1] = a[i, 1] + al2 * c[0] - al0 * c[2] + w2 * t1[0] - w0 * t1[2]
-        aG[2] = a[i, 2] + al0 * c[1] - al1 * c[0] + w0 * t1[1] - w1 * t1[0]
+        c, Iw = body_inertia(R, com, inertia, i)
+        wi, al = row3(w, i), row3(alpha, i)
+        t1 = cross(al, c)
+        t2 = cross(wi, cross(wi, c))
         m = mass[i]
-        for k in range(3):
-            wrench[i, k] = m * aG[k] - F[i, k]
-            t2[k] = Iw[k, 0] * w0 + Iw[k, 1] * w1 + Iw[k, 2] * w2
+        # aG = a + alpha x c + w x (w x c)
+        f = (m * (a[i, 0] + t1[0] + t2[0]) - F[i, 0], m * (a[i, 1] + t1[1] + t2[1]) - F[i, 1],
+             m * (a[i, 2] + t1[2] + t2[2]) - F[i, 2])
         # about the centre of mass: Iw alpha + w x Iw w - N; then about O_i: + c x f
-        f0, f1, f2 = wrench[i, 0], wrench[i, 1], wrench[i, 2]
-        for k in range(3):
-            t1[k] = Iw[k, 0] * al0 + Iw[k, 1] * al1 + Iw[k, 2] * al2 - N[i, k]
-        wrench[i, 3] = t1[0] + w1 * t2[2] - w2 * t2[1] + c[1] * f2 - c[2] * f1
-        wrench[i, 4] = t1[1] + w2 * t2[0] - w0 * t2[2] + c[2] * f0 - c[0] * f2
-        wrench[i, 5] = t1[2] + w0 * t2[1] - w1 * t2[0] + c[0] * f1 - c[1] * f0
+        t3 = cross(wi, (Iw[0] * wi[0] + Iw[1] * wi[1] + Iw[2] * wi[2],
+                        Iw[1] * wi[0] + Iw[3] * wi[1] + Iw[4] * wi[2],
+                        Iw[2] * wi[0] + Iw[4] * wi[1] + Iw[5] * wi[2]))
+        t4 = cross(c, f)
+        wrench[i, 0], wrench[i, 1], wrench[i, 2] = f
+        wrench[i, 3] = Iw[0] * al[0] + Iw[1] * al[1] + Iw[2] * al[2] - N[i, 0] + t3[0] + t4[0]
+        wrench[i, 4] = Iw[1] * al[0] + Iw[3] * al[1] + Iw[4] * al[2] - N[i, 1] + t3[1] + t4[1]
+        wrench[i, 5] = Iw[2] * al[0] + Iw[4] * al[1] + Iw[5] * al[2] - N[i, 2] + t3[2] + t4[2]
     for i in range(n - 1, -1, -1):   # children come after their parents: leaves first
         f0, f1, f2 = wrench[i, 0], wrench[i, 1], wrench[i, 2]
         m0, m1, m2 = wrench[i, 3], wrench[i, 4], wrench[i, 5]
@@ -80,26 +76,53 @@ def recursive_newton_euler(mass, com, inertia, parent, kind, ucol, R, r, w, alph
             wrench[p, 5] += m2 + x * f1 - y * f0
 
 
-@njit(**UNCOUNTED)
+@njit(**FUSED)
+def _ancestor_rows(parent, kind, ucol, r, S, M, i, col, f0, f1, f2, n0, n1, n2):
+    """Column ``col`` of ``M`` (and its row) on frame ``i`` and its ancestors: the wrench
+    ``(n, f)`` = ``IC_i s`` about ``O_i``, carried up the tree, dotted with each ancestor's
+    motion subspace."""
+    k = i
+    while k >= 0:
+        ck = ucol[k]
+        if ck >= 0:
+            for l_ in range(NU[kind[k]]):
+                s = (S[k, 0, l_] * n0 + S[k, 1, l_] * n1 + S[k, 2, l_] * n2
+                     + S[k, 3, l_] * f0 + S[k, 4, l_] * f1 + S[k, 5, l_] * f2)
+                M[ck + l_, col] = s
+                M[col, ck + l_] = s
+        p = parent[k]
+        if p >= 0:                   # the wrench about O_p: moment + (O_k - O_p) x force
+            x, y, z = r[k, 0] - r[p, 0], r[k, 1] - r[p, 1], r[k, 2] - r[p, 2]
+            n0, n1, n2 = n0 + y * f2 - z * f1, n1 + z * f0 - x * f2, n2 + x * f1 - y * f0
+        k = p
+
+
+@njit(**FUSED)
 def composite_mass_matrix_s(mass, com, inertia, parent, kind, ucol, R, r, S, IC, M, work):
-    """The mass matrix ``M`` (free speeds) by composite rigid bodies: ``IC[i]`` (6x6, a
-    workspace) the spatial inertia of the subtree of frame ``i`` about ``O_i``; for each
-    free speed ``k`` of frame ``i``, the wrench ``IC_i S_k`` moved up to every ancestor
-    ``j`` gives the row ``M[l, k] = S_l . W`` of ``j``'s speeds ``l``.  ``work``:
-    ``INVERSE_WORK`` floats."""
+    """The mass matrix ``M`` (free speeds) by composite rigid bodies: the inertia of the
+    subtree of frame ``i`` about ``O_i`` (world axes), a rigid body's, held as its mass
+    ``m``, first moment ``h = m c`` and inertia about ``O_i`` (``IC[i, 0, :4]``: ``m, h``;
+    ``IC[i, 1]``: ``xx, xy, xz, yy, yz, zz``; ``IC`` a workspace); for each free speed
+    ``k`` of frame ``i``, the wrench ``IC_i S_k`` moved up to every ancestor ``j`` gives
+    the row ``M[l, k] = S_l . W`` of ``j``'s speeds ``l``.  ``work``: ``INVERSE_WORK``
+    floats (not read)."""
     n = mass.shape[0]
-    Iw, Y = c_view(work, 0, (3, 3)), c_view(work, 9, (3, 3))
-    c, rho, Fw = c_view(work, 18, (3,)), c_view(work, 21, (3,)), c_view(work, 24, (6,))
-    Y6 = c_view(work, 30, (6, 3))
-    for i in range(n):
-        world_inertia(R, com, inertia, i, c, Iw, Y)
-        _spatial_inertia(mass[i], c, Iw, IC, i)
-    for i in range(n - 1, -1, -1):
+    for i in range(n):               # each body about its own origin
+        c, Iw = body_inertia(R, com, inertia, i)
+        m = mass[i]
+        cx, cy, cz = c
+        IC[i, 0, 0], IC[i, 0, 1], IC[i, 0, 2], IC[i, 0, 3] = m, m * cx, m * cy, m * cz
+        IC[i, 1, 0] = Iw[0] + m * (cy * cy + cz * cz)
+        IC[i, 1, 1] = Iw[1] - m * cx * cy
+        IC[i, 1, 2] = Iw[2] - m * cx * cz
+        IC[i, 1, 3] = Iw[3] + m * (cx * cx + cz * cz)
+        IC[i, 1, 4] = Iw[4] - m * cy * cz
+        IC[i, 1, 5] = Iw[5] + m * (cx * cx + cy * cy)
+    for i in range(n - 1, -1, -1):   # the subtrees, about their parents' origins
         p = parent[i]
         if p >= 0:
-            for a_ in range(3):
-                rho[a_] = r[i, a_] - r[p, a_]
-            _add_shifted_inertia(IC, i, p, rho, Y6)
+            _add_about_parent(IC, i, p, r[i, 0] - r[p, 0], r[i, 1] - r[p, 1],
+                              r[i, 2] - r[p, 2])
     for k in range(M.shape[0]):          # speeds on different branches do not couple
         for j in range(M.shape[1]):
             M[k, j] = 0.0
@@ -107,56 +130,62 @@ def composite_mass_matrix_s(mass, com, inertia, parent, kind, ucol, R, r, S, IC,
         col0 = ucol[i]
         if col0 < 0:
             continue
+        m, hx, hy, hz = IC[i, 0, 0], IC[i, 0, 1], IC[i, 0, 2], IC[i, 0, 3]
+        ixx, ixy, ixz, iyy, iyz, izz = (IC[i, 1, 0], IC[i, 1, 1], IC[i, 1, 2], IC[i, 1, 3],
+                                        IC[i, 1, 4], IC[i, 1, 5])
         for j in range(NU[kind[i]]):
-            for a_ in range(6):
-                s = 0.0
-                for b_ in range(6):
-                    s += IC[i, a_, b_] * S[i, b_, j]
-                Fw[a_] = s
-            k = i
-            while k >= 0:
-                ck = ucol[k]
-                if ck >= 0:
-                    for l_ in range(NU[kind[k]]):
-                        s = 0.0
-                        for a_ in range(6):
-                            s += S[k, a_, l_] * Fw[a_]
-                        M[ck + l_, col0 + j] = s
-                        M[col0 + j, ck + l_] = s
-                p = parent[k]
-                if p >= 0:           # the wrench about O_p: moment + (O_k - O_p) x force
-                    x, y, z = r[k, 0] - r[p, 0], r[k, 1] - r[p, 1], r[k, 2] - r[p, 2]
-                    Fw[0] += y * Fw[5] - z * Fw[4]
-                    Fw[1] += z * Fw[3] - x * Fw[5]
-                    Fw[2] += x * Fw[4] - y * Fw[3]
-                k = p
+            a0, a1, a2, l0, l1, l2 = (S[i, 0, j], S[i, 1, j], S[i, 2, j], S[i, 3, j],
+                                      S[i, 4, j], S[i, 5, j])
+            # IC s = (I a + h x l, m l - h x a) for s = (a, l)
+            _ancestor_rows(parent, kind, ucol, r, S, M, i, col0 + j,
+                           m * l0 - (hy * a2 - hz * a1), m * l1 - (hz * a0 - hx * a2),
+                           m * l2 - (hx * a1 - hy * a0),
+                           ixx * a0 + ixy * a1 + ixz * a2 + hy * l2 - hz * l1,
+                           ixy * a0 + iyy * a1 + iyz * a2 + hz * l0 - hx * l2,
+                           ixz * a0 + iyz * a1 + izz * a2 + hx * l1 - hy * l0)
+
+
+@njit(**FUSED)
+def _add_about_parent(IC, i, p, x, y, z):
+    """Add the rigid inertia ``IC[i]`` (``composite_mass_matrix_s``'s layout), moved from
+    ``O_i`` to ``O_p`` (``rho = (x, y, z) = O_i - O_p``), to ``IC[p]``: the mass, ``h +
+    m rho``, and ``I - rho h^T - h rho^T + 2 (h . rho) E + m (|rho|^2 E - rho rho^T)``."""
+    m, hx, hy, hz = IC[i, 0, 0], IC[i, 0, 1], IC[i, 0, 2], IC[i, 0, 3]
+    d = 2.0 * (hx * x + hy * y + hz * z) + m * (x * x + y * y + z * z)
+    IC[p, 0, 0] += m
+    IC[p, 0, 1] += hx + m * x
+    IC[p, 0, 2] += hy + m * y
+    IC[p, 0, 3] += hz + m * z
+    IC[p, 1, 0] += IC[i, 1, 0] + d - 2.0 * x * hx - m * x * x
+    IC[p, 1, 1] += IC[i, 1, 1] - x * hy - hx * y - m * x * y
+    IC[p, 1, 2] += IC[i, 1, 2] - x * hz - hx * z - m * x * z
+    IC[p, 1, 3] += IC[i, 1, 3] + d - 2.0 * y * hy - m * y * y
+    IC[p, 1, 4] += IC[i, 1, 4] - y * hz - hy * z - m * y * z
+    IC[p, 1, 5] += IC[i, 1, 5] + d - 2.0 * z * hz - m * z * z
 
 
 # The entries on the packed buffers (``packed``): one compiled call each.
 
 @njit(**UNCOUNTED)
-def inverse_dynamics_packed(fb, ib, t, forces, q, u, ud, tau):
+def inverse_dynamics_packed(fb, ib, forces, q, u, ud, tau):
     """Scatter ``q``, ``u``, ``u'``; the kinematics with those rates and the applied loads;
     then ``recursive_newton_euler``: ``tau`` (free speeds) and the joint wrenches in the
     ``W`` view.  ``forces``: the force table or None (``packed``).  Returns -1, or -2 when
-    ``tau`` holds NaN or Inf."""
+    ``tau`` holds NaN or Inf, or ``WRONG_SIZE`` for an argument of another size.  The
+    integer buffer stands for the offset table (``packed.articulated_accelerations_packed``)."""
+    t = ib
+    nu = t[1]
+    if q.shape[0] != t[7] or u.shape[0] != nu or ud.shape[0] != nu or tau.shape[0] != nu:
+        return WRONG_SIZE
     _scatter(fb, ib, t, q, u)
     udfull, free_u = fb[t[UDFULL]:], ib[t[FREE_U]:]
     for k in range(ud.shape[0]):
         udfull[free_u[k]] = ud[k]
-    tree, body, state, loads, _, motion, _, art, scratch = _views(fb, ib, t, forces)
-    mass, com, inertia, _, gravity = body
-    parent, kind, axis, seq, pos, C, qoff, uoff, ucol = tree[:9]
-    anc_ptr, anc_idx = art[0], art[1]            # empty: the kinematics fill S only
-    qfull, ufull, udf = state
-    R, r, w, v, alpha, a, JR, JT, S, F, N = motion
-    kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
-                         mass, com, gravity, qfull, ufull, udf, *loads, R, r, w, v, alpha, a,
-                         JR, JT, S, F, N, scratch)
-    if loads[7][0] == 0:                         # the gyroscopic effect switched off
-        drop_velocity_products(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr,
-                               anc_idx, qfull, ufull, udf, R, r, w, v, alpha, a, JR, JT, S,
-                               scratch)
+    tree, body, state, loads, _, kin, _, art, scratch = _views(fb, ib, t, forces)
+    motion_and_loads(tree, body, state, loads, kin, scratch)
+    mass, com, inertia = body[0], body[1], body[2]
+    parent, kind, ucol = tree[0], tree[1], tree[8]
+    R, r, w, v, alpha, a, _, _, S, F, N = kin
     recursive_newton_euler(mass, com, inertia, parent, kind, ucol, R, r, w, alpha, a, S, F, N,
                            art[8], tau, scratch)
     for k in range(tau.shape[0]):
@@ -166,24 +195,25 @@ def inverse_dynamics_packed(fb, ib, t, forces, q, u, ud, tau):
 
 
 @njit(**UNCOUNTED)
-def mass_matrix_packed(fb, ib, t, forces, q, M):
-    """Scatter ``q`` (speeds zero), the kinematics, then ``composite_mass_matrix_s`` into
+def mass_matrix_packed(fb, ib, forces, q, M):
+    """Scatter ``q``, the kinematics (positions only), then ``composite_mass_matrix_s`` into
     ``M`` (nu x nu); ``forces`` is not read (the packed kernels' arguments).  Returns -1,
-    or -2 when ``M`` holds NaN or Inf."""
-    ufull, free_u = fb[t[UFULL]:], ib[t[FREE_U]:]
+    or -2 when ``M`` holds NaN or Inf, or ``WRONG_SIZE`` for an argument of another size
+    (the integer buffer standing for the table)."""
+    t = ib
     nu = t[1]
-    tree, body, state, _, _, motion, _, art, scratch = _views(fb, ib, t, None)
+    if q.shape[0] != t[7] or M.shape[0] != nu or M.shape[1] != nu:
+        return WRONG_SIZE
+    tree, body, state, _, _, kin, _, art, scratch = _views(fb, ib, t, None)
     qfull = state[0]
     free_q = ib[t[FREE_Q]:]
     for k in range(q.shape[0]):
         qfull[free_q[k]] = q[k]
-    for k in range(nu):
-        ufull[free_u[k]] = 0.0
     mass, com, inertia, _, _ = body
     parent, kind, axis, seq, pos, C, qoff, uoff, ucol = tree[:9]
-    R, r, w, v, alpha, a, JR, JT, S, _, _ = motion
-    walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, art[0], art[1], qfull, state[1],
-         state[2], R, r, w, v, alpha, a, JR, JT, S, scratch)
+    R, r, w, v, alpha, a, JR, JT, S, _, _ = kin
+    motion(parent, kind, axis, seq, pos, C, qoff, uoff, qfull, state[1], state[2], R, r, w, v,
+           alpha, a, S, scratch, 0)
     composite_mass_matrix_s(mass, com, inertia, parent, kind, ucol, R, r, S, art[2], M,
                             scratch)
     for k in range(nu):

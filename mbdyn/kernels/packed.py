@@ -27,11 +27,15 @@ of them held anywhere, stay as they are.
 import numpy as np
 from numba import njit
 
-from .evaluate import (articulated_accelerations, jourdain_accelerations, newton_euler_solution,
+from .articulated import articulated_body
+from .evaluate import (jourdain_accelerations, motion_and_loads, newton_euler_solution,
                        newton_euler_tree)
 from .forces import ROW
 from .joints import coordinate_rates
 from .views import UNCOUNTED, c_view, far_view, untracked
+
+#: what a packed entry returns for an argument of the wrong size (before it reads it)
+WRONG_SIZE = -3
 
 #: float arrays in buffer order, with their shapes in terms of the sizes below
 FLOATS = ("gravity", "axis", "pos", "C", "mass", "com", "inertia", "load_point", "load_force",
@@ -69,13 +73,31 @@ NANC, NJ, NM, NPTR = 5, 12, 13, 14
                                          len(SIZES) + len(FLOATS) + len(INTS) + len(FAR))
 
 
-def pack(floats, ints, far):
+#: arrays a merged tree (``compiled.merging``: rigidly attached frames merged into their
+#: carriers) has of its own, in the same buffers: its tree and bodies, and the workspace
+#: sized by its frames (so that its evaluations leave the full tree's as they were);
+#: every other entry of its table is the full tree's (the state, loads, force data,
+#: scratch: what Python writes between calls is seen by both)
+MERGED_FLOATS = ("axis", "pos", "C", "mass", "com", "inertia", "R", "r", "w", "v", "alpha",
+                 "a", "S", "F", "N", "f", "ud", "IA", "pA", "cb", "U", "Dl", "acc", "W")
+MERGED_INTS = ("parent", "kind", "seq", "qoff", "uoff", "ucol", "has_inertia", "load_body",
+               "force_int")
+
+
+def pack(floats, ints, far, merged=None):
     """Copy the arrays of ``floats`` and ``ints`` (dicts by the names in ``FLOATS``,
     ``INTS``) into two buffers, and ``place`` the arrays of ``far``.  Returns ``(fbuf,
     ibuf, table, views)``: ``table`` holds the sizes (``SIZES``), then each array's
     offset, then the ``FAR`` arrays' addresses; ``views[name]`` is the array's view.
     The table is also the head of ``ibuf`` (``table`` is that view): ``ibuf`` can stand for
-    the table, so that an entry point takes one array less (``mbdyn.compiled.lowlevel``)."""
+    the table, so that an entry point takes one array less (``mbdyn.compiled.lowlevel``).
+
+    ``merged`` (``compiled.merging.plan``: its frame count ``n`` and the arrays of
+    ``MERGED_FLOATS``, ``MERGED_INTS`` it has) adds a merged tree in the same float
+    buffer; it returns, after the rest, ``(ibuf2, views2)``: a copy of ``ibuf`` (whose
+    numbers are all fixed at compile) holding the merged tree's integer arrays, its head
+    the merged tree's table, and the views of its arrays by name; else ``(None, None)``.
+    """
     sizes = {"n": floats["mass"].shape[0], "nu": floats["ud"].shape[0],
              "nl": floats["load_force"].shape[0], "nqf": floats["qfull"].shape[0],
              "nuf": floats["ufull"].shape[0], "nreact": ints["react_joint"].shape[0],
@@ -84,19 +106,26 @@ def pack(floats, ints, far):
              "nscratch": floats["scratch"].shape[0]}
     table = np.zeros(len(SIZES) + len(FLOATS) + len(INTS) + len(FAR), np.int64)
     table[:len(SIZES)] = [sizes.get(s, 0) for s in SIZES]
-    views = {}
+    extra = {FLOATS: [], INTS: []}
+    if merged is not None:
+        extra[FLOATS] = [(name, _merged_array(name, floats[name], merged))
+                         for name in MERGED_FLOATS]
+        extra[INTS] = [(name, merged[name]) for name in MERGED_INTS]
+    views, views2, offsets2 = {}, {}, {}
     for names, source, dtype in ((FLOATS, floats, np.float64), (INTS, ints, np.int64)):
         first = len(SIZES) + (0 if names is FLOATS else len(FLOATS))
         head = 0 if names is FLOATS else table.shape[0]
-        total = head + sum(np.asarray(source[k]).size for k in names)
-        buf = np.zeros(total, dtype)
+        arrays = [(name, np.asarray(source[name])) for name in names] + extra[names]
+        buf = np.zeros(head + sum(arr.size for _, arr in arrays), dtype)
         at = head
-        for k, name in enumerate(names):
-            arr = np.asarray(source[name])
-            table[first + k] = at
+        for k, (name, arr) in enumerate(arrays):
+            if k < len(names):
+                table[first + k] = at
+            else:
+                offsets2[first + names.index(name)] = at
             view = buf[at:at + arr.size].reshape(arr.shape)
             view[...] = arr
-            views[name] = view
+            (views if k < len(names) else views2)[name] = view
             at += arr.size
         if names is FLOATS:
             fbuf = buf
@@ -105,7 +134,28 @@ def pack(floats, ints, far):
     ibuf[:table.shape[0]] = table
     table = ibuf[:table.shape[0]]
     place(table, far)
-    return fbuf, ibuf, table, views
+    if merged is None:
+        return fbuf, ibuf, table, views, None, None
+    ibuf2 = ibuf.copy()
+    table2 = ibuf2[:table.shape[0]]
+    for k, at in offsets2.items():
+        table2[k] = at
+    for name in MERGED_INTS:                   # its integer arrays as views of its buffer
+        at, arr = table2[len(SIZES) + len(FLOATS) + INTS.index(name)], views2[name]
+        views2[name] = ibuf2[at:at + arr.size].reshape(arr.shape)
+    table2[0] = merged["n"]
+    for k in (NANC, 6, NJ, NM, NPTR):          # no full Jacobians, no reaction components
+        table2[k] = 0
+    return fbuf, ibuf, table, views, ibuf2, views2
+
+
+def _merged_array(name, full, merged):
+    """The merged tree's float array ``name``: its own data, or a workspace array shaped
+    as the full tree's with its frame count first (``f`` and ``ud`` have the speeds')."""
+    if name in merged:
+        return np.asarray(merged[name], float)
+    shape = full.shape if name in ("f", "ud") else (merged["n"],) + full.shape[1:]
+    return np.zeros(shape)
 
 
 def place(table, far):
@@ -205,9 +255,14 @@ def _scatter(fb, ib, t, q, u):
 
 
 @njit(**UNCOUNTED)
-def jourdain_accelerations_packed(fb, ib, t, forces, q, u):
+def jourdain_accelerations_packed(fb, ib, forces, q, u):
     """Scatter ``q``, ``u``, then ``evaluate.jourdain_accelerations`` on packed arrays (same
-    return value; ``u'`` is left in the ``ud`` view)."""
+    return value, or ``WRONG_SIZE`` for ``q`` or ``u`` of another size; ``u'`` is left in
+    the ``ud`` view).  The integer buffer stands for the offset table, as in
+    ``articulated_accelerations_packed``."""
+    t = ib
+    if q.shape[0] != t[7] or u.shape[0] != t[1]:
+        return WRONG_SIZE
     _scatter(fb, ib, t, q, u)
     tree, body, state, loads, _, motion, jourdain, _, scratch = _views(fb, ib, t, forces)
     return jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch)
@@ -259,24 +314,42 @@ def newton_euler_solution_packed(fb, ib, t, forces, q, u, A, b):
 
 
 @njit(**UNCOUNTED)
-def articulated_accelerations_packed(fb, ib, t, forces, q, u):
-    """Scatter ``q``, ``u``, then ``evaluate.articulated_accelerations`` on packed arrays
-    (same return value; ``u'`` is left in the ``ud`` view)."""
+def articulated_accelerations_packed(fb, ib, forces, q, u):
+    """Scatter ``q``, ``u``, then ``evaluate.articulated_accelerations`` on packed arrays,
+    its kinematics by ``motion`` (``evaluate.motion_and_loads``): the same return value,
+    or ``WRONG_SIZE`` for ``q`` or ``u`` of another size; ``u'`` is left in the ``ud``
+    view.  The integer buffer stands for the offset table (its head, ``pack``): an
+    argument less for numba to check at each call from Python."""
+    t = ib
+    if q.shape[0] != t[7] or u.shape[0] != t[1]:
+        return WRONG_SIZE
     _scatter(fb, ib, t, q, u)
-    tree, body, state, loads, _, motion, jourdain, art, scratch = _views(fb, ib, t, forces)
+    tree, body, state, loads, _, kin, jourdain, art, scratch = _views(fb, ib, t, forces)
     mass, com, inertia, _, gravity = body
-    return articulated_accelerations(tree[:9] + art[:2], (mass, com, inertia, gravity), state,
-                                     loads, motion, art[2:8], jourdain[3], scratch)
+    motion_and_loads(tree, body, state, loads, kin, scratch)
+    parent, kind, ucol = tree[0], tree[1], tree[8]
+    R, r, w, v, alpha, a, _, _, S, F, N = kin
+    IA, pA, cb, U, Dl, acc = art[2:8]
+    ud = jourdain[3]
+    pivot = articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha, a, S, F,
+                             N, IA, pA, cb, U, Dl, acc, ud, scratch)
+    if pivot >= 0:
+        return pivot
+    for k in range(ud.shape[0]):
+        if not np.isfinite(ud[k]):
+            return -2
+    return -1
 
 
 @njit(**UNCOUNTED)
-def state_derivative_articulated_packed(fb, ib, t, forces, y, ydot):
-    """``state_derivative_packed`` with ``u'`` by the articulated-body algorithm."""
-    nq = t[7]
-    pivot = articulated_accelerations_packed(fb, ib, t, forces, y[:nq], y[nq:])
+def state_derivative_articulated_packed(fb, ib, forces, y, ydot):
+    """``state_derivative_packed`` with ``u'`` by the articulated-body algorithm (the
+    integer buffer standing for the table, as ``articulated_accelerations_packed``)."""
+    nq = ib[7]
+    pivot = articulated_accelerations_packed(fb, ib, forces, y[:nq], y[nq:])
     if pivot >= 0:
         return pivot
-    return _state_rates(fb, ib, t, y, ydot)
+    return _state_rates(fb, ib, ib, y, ydot)
 
 
 @njit(**UNCOUNTED)

@@ -19,6 +19,11 @@ from numba.np.arrayobj import make_array, populate_array
 #: ``np.linalg``) and must not return an array: it works in the arrays and scratch it is
 #: given, and may call counted kernels that allocate and free inside themselves.
 UNCOUNTED = {"cache": True, "_nrt": False}
+#: ``UNCOUNTED`` for the per-call dynamics' arithmetic (``motion``, ``spatial``, the
+#: articulated bodies, inverse dynamics, composite rigid bodies): a product and a sum may
+#: be fused into one rounding (``a * b + c`` as an FMA where the processor has it), the
+#: only licence of fast-math taken -- NaN and Inf keep their meaning, sums their order
+FUSED = {"cache": True, "_nrt": False, "fastmath": {"contract"}}
 
 
 def _view(context, builder, view_type, src, data, shape):
