@@ -120,3 +120,7 @@ MAX_BEAM_ELEMENTS = 1000
 #: modal coordinates of one reduced body, and nodes of user-supplied reduced data
 MAX_MODES = 500
 MAX_FLEXIBLE_NODES = 100_000
+#: modes of one flexible body the symbolic layer writes in closed form (``mbdyn eom``):
+#: each mode adds a row and column of named invariants (J1, J2's pairs, Cr1), and the
+#: expressions grow with their products
+MAX_SYMBOLIC_MODES = 4

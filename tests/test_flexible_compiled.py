@@ -108,6 +108,7 @@ def test_compiled_terms_are_opt_in():
     assert m.compiled_terms and not m.has_callable_loads      # the compiled loops
 
 
+@pytest.mark.filterwarnings("ignore:.*gyroscopic effect is off")
 def test_elements_read_the_true_speeds_with_the_gyroscopic_effect_off():
     """A damper's force does not depend on the gyroscopic switch: its share of ``f``
     (with minus without it) is the same with the effect on and off (numpy's route)."""
@@ -123,6 +124,7 @@ def test_elements_read_the_true_speeds_with_the_gyroscopic_effect_off():
 
 
 @pytest.mark.slow
+@pytest.mark.filterwarnings("ignore:.*gyroscopic effect is off")
 @pytest.mark.parametrize("name", sorted(OPEN))
 def test_compiled_terms_equal_numpys(name):
     m = OPEN[name]()

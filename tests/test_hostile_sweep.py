@@ -769,10 +769,11 @@ def test_a_real_scheduler_without_workers_or_stopped_ends_in_bounded_time(tmp_pa
                     "the Dask scheduler did not start within 90 s"
                 time.sleep(0.3)
         start = time.monotonic()
+        # 5 s: on a loaded machine a live scheduler may take over 2 s to answer
         with pytest.raises(mb.ModelError, match=re.escape(address) + r" has had no workers "
-                           r"for 2 s; start some with `dask worker"):
-            sweep(str(tmp_path / "model.toml"), GRID, scheduler=address, scheduler_timeout=2)
-        assert time.monotonic() - start < 30
+                           r"for 5 s; start some with `dask worker"):
+            sweep(str(tmp_path / "model.toml"), GRID, scheduler=address, scheduler_timeout=5)
+        assert time.monotonic() - start < 45
         client = DaskScheduler(address, timeout=2)
         proc.send_signal(signal.SIGSTOP)
         start = time.monotonic()

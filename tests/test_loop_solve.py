@@ -189,3 +189,81 @@ def test_runs_by_the_articulated_route():
     th2 = res.q[:, fb.coordinate_index("th2")]
     assert abs(res.stats["singular_configuration"]["t"] - np.interp(np.pi, th2, res.t)) <= 0.011
     np.testing.assert_allclose(res.q[:, fb.coordinate_index("th4")], th2, atol=1e-8)
+
+
+def test_min_norm_step_on_chosen_rows_equals_least_squares():
+    """A run's minimum-norm step (``min_norm.min_norm_step``) equals numpy's least
+    squares on 200 random consistent problems with redundant rows: first by the pivoted
+    factorisation (which records its rows and their conditioning), then on the rows it
+    chose; rows that lost their conditioning are chosen again."""
+    from mbdyn.kernels.loop_solve import ROWS
+    from mbdyn.kernels.min_norm import min_norm_step, min_norm_work
+    rng = np.random.default_rng(11)
+    for trial in range(200):
+        nu, m = int(rng.integers(1, 9)), int(rng.integers(1, 16))
+        r = int(rng.integers(1, min(nu, m) + 1))
+        G = rng.standard_normal((m, r)) @ rng.standard_normal((r, nu))
+        rhs = G @ rng.standard_normal(nu)
+        ref = np.linalg.lstsq(G, rhs, rcond=1e-9)[0]
+        info, work = np.zeros(ROWS + 2 + m), np.empty(min_norm_work(m))
+        info[ROWS] = -1.0
+        for path in ("pivoted", "chosen"):
+            du = np.zeros(nu)
+            ratio = min_norm_step(G, rhs, r, du, info, work)
+            assert info[ROWS] == r and 0 < ratio <= 1, (trial, path)
+            assert np.abs(du - ref).max() <= 1e-8 * (1 + np.abs(ref).max()), (trial, path)
+        chosen = info[ROWS + 1:ROWS + 1 + r].copy()
+        if r < m:                                     # a weak row among the chosen ones
+            weak = int(np.argmin(np.abs(G).sum(axis=1)))
+            G[weak] *= 1e-4
+            rhs = G @ rng.standard_normal(nu)
+            if weak in chosen:
+                min_norm_step(G, rhs, r, np.zeros(nu), info, work)
+                assert weak not in info[ROWS + 1:ROWS + 1 + r] or np.linalg.matrix_rank(
+                    np.delete(G, weak, axis=0), 1e-9) < r, trial
+
+
+@pytest.mark.parametrize("path, case", [("models/andrews_squeezer.toml", None),
+                                        ("models/four_bar.toml", "free")])
+def test_projection_steps_on_the_chosen_rows(path, case):
+    """A run's projection takes its minimum-norm steps on the rows the last pivoted
+    factorisation chose (``min_norm._min_norm_chosen``: ``r x r``, no pivoting) while they
+    keep their conditioning: the projected state equals the one the pivoted steps give (to
+    rounding), the rows stay chosen; a zero row among them (as near a singular
+    configuration) fails the conditioning test and the rows are chosen again."""
+    from mbdyn.kernels.loop_solve import ROWS
+    scene = mb.load_model(path, case)
+    m = scene.model
+    info = m._con[7]
+    nrows = len(m.constraint_rows)
+    rng = np.random.default_rng(3)
+    q0, u0 = m.project(scene.q0, scene.u0 + 0.3)
+    rank = m.constraint_rank(q0)[0]
+    try:
+        info[2] = rank                                # as a run holds it
+        m.project(q0, u0)                             # the pivoted steps choose the rows
+        chosen = info[ROWS:ROWS + 1 + rank].copy()
+        assert info[ROWS] == rank < nrows and info[ROWS + 1 + nrows] > 0
+        for trial in range(5):
+            dq = 1e-6 * rng.standard_normal(m.nq)
+            du = 1e-3 * rng.standard_normal(m.nu)
+            info[ROWS] = -1.0                         # pivoted steps: the reference
+            q_ref, u_ref = m.project(q0 + dq, u0 + du)
+            info[ROWS:ROWS + 1 + rank] = chosen
+            q_fast, u_fast = m.project(q0 + dq, u0 + du)
+            assert np.array_equal(info[ROWS:ROWS + 1 + rank], chosen), trial
+            assert np.abs(q_fast - q_ref).max() <= 1e-13, trial
+            assert np.abs(u_fast - u_ref).max() <= 1e-12 * (1 + np.abs(u_ref).max()), trial
+            phi, psi = m.constraint_residuals(q_fast, u_fast)
+            assert np.abs(phi).max() <= 1e-13 and np.abs(psi).max() <= 1e-12
+        G = m.constraint_jacobian(q0)
+        zero = [k for k in range(nrows) if not G[k].any()]
+        if zero:                                      # a planar loop's out-of-plane row
+            info[ROWS:ROWS + 1 + rank] = chosen
+            info[ROWS + 1] = zero[0]
+            q1, u1 = m.project(q0 + dq, u0 + du)
+            assert zero[0] not in info[ROWS + 1:ROWS + 1 + rank]
+            assert np.abs(q1 - q_ref).max() <= 1e-13
+            assert np.abs(u1 - u_ref).max() <= 1e-12 * (1 + np.abs(u_ref).max())
+    finally:
+        info[2] = info[ROWS] = -1.0

@@ -26,24 +26,29 @@ from ..flexible.invariants import cross3, quadratic_velocity_vector
 from ..kernels import constraints as kcon
 from ..kernels import dynamics as kd
 from ..kernels.loop_solve import RANK_TOLERANCE
+from . import flexible_newton_euler
 from .flexible_dynamics import body_matrix, split
 from .flexible_forces import wrenches
 from .loop_reactions import UNIQUE_TOLERANCE
 
-METHODS = ("auto", "newton-euler", "jourdain")
+METHODS = ("auto", "jourdain", "newton-euler", "newton-euler-dense")
 
 
 def reactions(model, q, u, t=0.0, method="auto", frame="world"):
     """``{joint: (F, M)}`` of the model's joints (tree joints at their origin, loop
     joints at their point on the child), world components or the child frame's
-    (``frame="child"``); ``method``: the accelerations are the Jourdain route's, the
-    wrenches Newton-Euler's (module docstring), whichever is asked."""
+    (``frame="child"``); ``method``: ``"auto"`` and ``"jourdain"``: the Jourdain route's
+    accelerations, then inverse dynamics (module docstring); ``"newton-euler"`` (or
+    ``"-dense"``): the system with reaction unknowns (``flexible_newton_euler``)."""
     if frame not in ("world", "child"):
         raise ModelError(f"unknown frame {frame!r} for reactions; use 'world' or 'child'")
     if method not in METHODS:
         raise ModelError(f"model {model.name!r} has flexible bodies: reactions take method "
                          f"{', '.join(repr(m) for m in METHODS)}, not {method!r}")
     q, u = split(model, q, u)
+    if method in flexible_newton_euler.METHODS:
+        return flexible_newton_euler.reactions_of(
+            model, flexible_newton_euler.solve(model, q, u, t), frame)
     if model.has_loops:
         ud, lam = model.multipliers(q, u, t)
     else:

@@ -20,6 +20,7 @@ from ..algorithms import flexible_dynamics as flex
 from ..algorithms import flexible_forces
 from ..algorithms import flexible_kernels as compiled
 from ..algorithms import flexible_loops as flex_loops
+from ..algorithms import flexible_newton_euler as flex_ne
 from ..algorithms import flexible_reactions as flex_reactions
 from ..errors import ModelError
 from .flexible_packing import FlexibleKernels
@@ -219,19 +220,27 @@ class FlexibleModel(Model):
     #: loops do so for rigid mechanisms)
     projects_steps = True
 
-    #: ``u'``: of ``M u' = f``, or with loops of ``M u' = f + G^T lam``, ``G u' = gamma``
-    #: (compiled, ``algorithms.flexible_kernels``; numpy's ``flexible_dynamics`` and
-    #: ``flexible_loops`` are the reference)
-    forward_dynamics = compiled.forward_dynamics
+    def forward_dynamics(self, q, u, t=0.0, method="jourdain"):
+        """``u'``: of ``M u' = f``, or with loops of ``M u' = f + G^T lam``,
+        ``G u' = gamma`` (``algorithms.flexible_kernels``: compiled with
+        ``compiled_terms``, else numpy's ``flexible_dynamics``, ``flexible_loops``);
+        ``"newton-euler"`` (or ``"-dense"``): the system with reaction unknowns
+        (``algorithms.flexible_newton_euler``)."""
+        if method in flex_ne.METHODS:
+            return flex_ne.forward_dynamics(self, q, u, t)
+        return compiled.forward_dynamics(self, q, u, t, method)
 
     def formulation(self, method="auto"):
-        """``"jourdain"`` for ``"auto"`` and ``"jourdain"``; the other routes are refused."""
+        """``"jourdain"`` for ``"auto"`` and ``"jourdain"``, the Newton-Euler routes as
+        named; ``"articulated"`` is refused."""
         if method in ("auto", "jourdain"):
             return "jourdain"
+        if method in flex_ne.METHODS:
+            return method
         raise ModelError(f"model {self.name!r} has flexible bodies "
-                         f"({', '.join(self.flexible_bodies)}): only method 'jourdain' (or "
-                         f"'auto') is there for them, in Python; {method!r} is the next "
-                         "step")
+                         f"({', '.join(self.flexible_bodies)}): methods 'jourdain' (or "
+                         f"'auto'), 'newton-euler' and 'newton-euler-dense' are there for "
+                         f"them, in Python; not {method!r}")
 
     # the tree's frames (the node frames among them, moved by the modal coordinates)
     def _tree_state(self, q, u=None, ud=None):
@@ -309,7 +318,7 @@ class FlexibleModel(Model):
         out = self.reactions(q, u, t, frame=frame)
         return np.array([np.concatenate(out[name]) for name in self.joints])
 
-    newton_euler = _not_yet("newton_euler")
+    newton_euler = flex_ne.newton_euler
     inverse_dynamics = _not_yet("inverse_dynamics")
     inverse_dynamics_along = _not_yet("inverse_dynamics_along")
     lowlevel = _not_yet("the low-level compiled entry")

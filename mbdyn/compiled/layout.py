@@ -312,7 +312,8 @@ def constraints(model, loop_joints):
     workspace: ``model._con = (con_int, con_data, phi, psi, G, gamma, lam, info)``, or
     None for a tree.  ``info``: rank, conditioning, the rank a run holds (-1: none), the
     lowest rank and conditioning a run met at its steps, then how many rows the last
-    projection chose (-1: none) and those rows (``kernels.loop_solve.ROWS``)."""
+    projection chose (-1: none), those rows and that factorisation's conditioning
+    (``kernels.loop_solve.ROWS``)."""
     model.loop_joints = tuple(j.name for j in loop_joints)
     model._loop_joint = {j.name: j for j in loop_joints}
     if not loop_joints:
@@ -334,7 +335,7 @@ def constraints(model, loop_joints):
     # two arrays, not eight
     nprim, nu = con_int.shape[0], model.nu
     cf = np.zeros(kc.con_floats(nprim, m, nu))
-    ends = np.cumsum([0, nprim * DATA, m, m, m * nu, m, m, m + 6])
+    ends = np.cumsum([0, nprim * DATA, m, m, m * nu, m, m, m + 7])
     views = [cf[a:b] for a, b in zip(ends[:-1], ends[1:])]
     views[0], views[3] = views[0].reshape(nprim, DATA), views[3].reshape(m, nu)
     views[0][...] = con_data

@@ -26,7 +26,9 @@ from .constraints import (DATA, POINT, ROW_WORK, _constraint_rows, constrained_j
 from .evaluate import jourdain_accelerations
 from .joints import coordinate_rates
 from .kinematics import walk
-from .loop_solve import augmented_solve, constrained_solve, min_norm_step, rank_of, solve_work
+from .loop_solve import (ROWS, augmented_solve, chosen_solve, constrained_solve, rank_of,
+                         solve_work)
+from .min_norm import min_norm_step
 from .packed import _scatter, _views
 from .views import UNCOUNTED, c_view, untracked
 
@@ -49,6 +51,15 @@ def constrained_accelerations(tree, body, state, loads, motion, jourdain, con, s
     con_int, con_data, phi, psi, G, gamma, lam, info = con
     pivot = jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch)
     # the scratch is free once M and f are made (loop_work: sized for the rows and solves)
+    if pivot == -1 and info[2] > 0 and info[ROWS] == info[2]:
+        # a run: only the rows its last projection chose, and the solve on them
+        _constraint_rows(con_int, con_data, tree[8], tree[6], tree[7], qfull, ufull,
+                         udfull, R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch,
+                         info[ROWS + 1:], int(info[ROWS]))
+        if chosen_solve(L, ud, G, gamma, lam, info, scratch):
+            return _finite(ud)
+        info[ROWS] = -1.0            # no longer independent: every row, pivoted, until the
+                                     # next projection chooses again
     _constraint_rows(con_int, con_data, tree[8], tree[6], tree[7], qfull, ufull, udfull,
                      R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch)
     if pivot >= 0:
@@ -58,6 +69,12 @@ def constrained_accelerations(tree, body, state, loads, motion, jourdain, con, s
             return pivot
     elif pivot == -1:
         constrained_solve(M, L, ud, G, gamma, lam, info, scratch)
+    return _finite(ud)
+
+
+@njit(cache=True, inline="always")
+def _finite(ud):
+    """-1 (done) when every entry of ``ud`` is finite, else -2."""
     for k in range(ud.shape[0]):
         if not np.isfinite(ud[k]):
             return -2
@@ -102,7 +119,7 @@ def project_state(y, nq, slots, quats, free_q, free_u, tree, state, motion, con,
             break
         if steps == PROJECTION_ITERATIONS:
             return -1
-        min_norm_step(G, phi, int(info[2]), du, info)
+        min_norm_step(G, phi, int(info[2]), du, info, scratch)
         coordinate_rates(y[:nq], du, slots, dq)
         for k in range(nq):
             y[k] -= dq[k]
@@ -112,7 +129,7 @@ def project_state(y, nq, slots, quats, free_q, free_u, tree, state, motion, con,
             for k in range(4):
                 y[i + k] /= nrm
         steps += 1
-    ratio = min_norm_step(G, psi, int(info[2]), du, info)
+    ratio = min_norm_step(G, psi, int(info[2]), du, info, scratch)
     for k in range(nu):
         y[nq + k] -= du[k]
     if info[2] >= 0:                 # a run: the rank here, for the next step's stages
@@ -157,7 +174,7 @@ def loop_work(n, nu, m):
 
 def con_floats(nprim, m, nu):
     """Floats of the constraints' buffer (``con_views``)."""
-    return nprim * DATA + 4 * m + m * nu + 6 + m
+    return nprim * DATA + 4 * m + m * nu + 7 + m
 
 
 @njit(inline="always", **UNCOUNTED)
@@ -173,7 +190,7 @@ def con_views(con_int, cf, nu):
     return (con_int, c_view(cf, 0, (nprim, DATA)), cf[at:at + m], cf[at + m:at + 2 * m],
             c_view(cf, at + 2 * m, (m, nu)), cf[at + 2 * m + m * nu:at + 3 * m + m * nu],
             cf[at + 3 * m + m * nu:at + 4 * m + m * nu],
-            cf[at + 4 * m + m * nu:at + 5 * m + m * nu + 6])
+            cf[at + 4 * m + m * nu:at + 5 * m + m * nu + 7])
 
 
 @njit(**UNCOUNTED)

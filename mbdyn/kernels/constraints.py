@@ -33,7 +33,7 @@ from .views import UNCOUNTED, c_view
 
 POINT, PERP, SLIDE, DIST, COUPLE = 0, 1, 2, 3, 4
 #: rows each primitive contributes
-ROWS = (3, 1, 1, 1, 1)
+ROWS = np.array((3, 1, 1, 1, 1), np.int64)
 #: floats of ``con_data`` per primitive
 DATA = 14
 
@@ -162,6 +162,15 @@ def _clean(G, Gabs):
                 G[row, col] = 0.0
 
 
+@njit(cache=True, inline="always")
+def _holds_chosen(row, count, chosen, nchosen):
+    """Whether one of the rows ``chosen[:nchosen]`` lies in ``row .. row + count - 1``."""
+    for j in range(nchosen):
+        if row <= chosen[j] < row + count:
+            return True
+    return False
+
+
 def constraint_count(con_int):
     """Rows of ``G`` the primitives ``con_int`` give."""
     return int(sum(ROWS[k] for k in con_int[:, 0])) if len(con_int) else 0
@@ -184,9 +193,12 @@ ROW_WORK = 57
 
 @njit(**UNCOUNTED)
 def _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
-                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, work):
+                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, work, chosen=None,
+                     nchosen=-1):
     """``constraint_rows`` in the scratch ``work`` (one allocation by the caller: the
-    vectors below are views of it, which cost no allocation each)."""
+    vectors below are views of it, which cost no allocation each).  Given ``chosen``, only
+    the primitives holding one of the rows ``chosen[:nchosen]`` (row numbers, as floats)
+    are evaluated, the other rows left zero (a run solves on the rows it last chose)."""
     # long: one loop over the primitives, each kind's rows written where they are derived
     # (a reader checks a kind's residual, rate, Jacobian and gamma side by side).
     w0, rp, Pp, vp = (c_view(work, 0, (3,)), c_view(work, 3, (3,)), c_view(work, 6, (3,)),
@@ -208,6 +220,9 @@ def _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
     row = 0
     for m in range(con_int.shape[0]):
         kind, ip, ic = con_int[m, 0], con_int[m, 1], con_int[m, 2]
+        if chosen is not None and not _holds_chosen(row, ROWS[kind], chosen, nchosen):
+            row += ROWS[kind]
+            continue
         sp, sc = con_data[m, 0:3], con_data[m, 3:6]
         A, B = con_data[m, 6:9], con_data[m, 9:12]
         wp = w[ip] if ip >= 0 else w0

@@ -1,5 +1,5 @@
 """Rank-tolerant solves of the constrained equations ``M u' = f + G^T lam``, ``G u' = gamma``
-(``kernels.constrained``) and of the projection's minimum-norm steps.
+(``kernels.constrained``); the projection's minimum-norm steps are in ``kernels.min_norm``.
 
 Outside runs the rank is decided by a rank-revealing (column-pivoted) QR of ``Y = L^-1 G^T``
 (``constrained_solve``, ``kernels.rank_qr``) and the multipliers are the minimum-norm ones.  A run knows its
@@ -27,7 +27,8 @@ RANK_TOLERANCE = 1e-9
 PASSAGE_TOLERANCE = 1e-6
 #: ``info`` (``compiled.layout.constraints``): rank, conditioning, the rank a run holds (-1:
 #: none), the lowest rank and conditioning a run met; then, from ``ROWS``, how many rows
-#: the last pivoted factorisation of a projection chose (-1: none yet) and those rows
+#: the last pivoted factorisation of a projection chose (-1: none yet), those rows (``m``
+#: slots), and last the conditioning of that factorisation (``chosen_conditioning``)
 ROWS = 5
 
 
@@ -163,13 +164,32 @@ def _pivoted_solve(L, ud, G, gamma, lam, info, keep, work):
     info[1] = A[rank - 1, rank - 1] / np.sqrt(first) if rank and first > 0 else 1.0
 
 
+@njit(**UNCOUNTED)
+def chosen_solve(L, ud, G, gamma, lam, info, work):
+    """A run's constrained ``ud`` (holding ``M^-1 f``) on the rows its last projection
+    chose (``_chosen_rows_solve``), when it has chosen as many as the rank it holds.
+    Returns False, having changed nothing but ``work``, when there are no such rows or
+    they are no longer independent enough (then the caller evaluates every row and
+    pivots: ``constrained_solve``)."""
+    keep = int(info[2])
+    if keep <= 0 or info[ROWS] != keep:
+        return False
+    m, nu = G.shape[0], G.shape[1]
+    Y, A = c_view(work, 0, (nu, keep)), c_view(work, nu * keep, (keep, keep))
+    at = nu * keep + keep * keep
+    res, x, z = (c_view(work, at, (m,)), c_view(work, at + m, (keep,)),
+                 c_view(work, at + m + keep, (nu,)))
+    return _chosen_rows_solve(L, ud, G, gamma, lam, info, keep, Y, A, res, x, z)
+
+
 @njit(cache=True, inline="always")
 def _schur_rows(L, ud, G, gamma, rows, r, Y, A, res):
-    """The residual ``res = gamma - G ud`` (every row); for the rows ``rows[:r]`` (row
-    numbers, as floats) ``Y = L^-1 G_r^T`` and ``A = Y^T Y`` (both triangles), the Schur
+    """For the rows ``rows[:r]`` (row numbers, as floats): the residual ``res = gamma -
+    G ud`` at those rows, ``Y = L^-1 G_r^T`` and ``A = Y^T Y`` (both triangles), the Schur
     complement ``G_r M^-1 G_r^T``.  Returns ``A``'s largest diagonal entry."""
-    m, nu = G.shape[0], G.shape[1]
-    for i in range(m):
+    nu = G.shape[1]
+    for j in range(r):
+        i = int(rows[j])
         s = gamma[i]
         for k in range(nu):
             s -= G[i, k] * ud[k]
@@ -219,50 +239,6 @@ def _chosen_rows_solve(L, ud, G, gamma, lam, info, r, Y, A, res, x, z):
     info[0] = r
     info[1] = A[r - 1, r - 1] / np.sqrt(first) if first > 0 else 1.0
     return True
-
-
-@njit(cache=True, _nrt=True)   # allocates: counted even under an uncounted caller
-def min_norm_step(G, rhs, keep, du, info):
-    """``du``: the minimum-norm solution of ``G du = rhs`` -- by ``G^T (G G^T)^+ rhs`` on
-    the rows a pivoted Cholesky of ``G G^T`` keeps (``keep`` at most) during a run, by
-    least squares (SVD) when the rank is not known (``keep < 0``).  Returns the last
-    pivot's singular value over the first's (an estimate of ``G``'s conditioning; 1.0
-    by least squares).  The rows the factorisation chose are kept in ``info[ROWS:]`` for
-    the evaluations that follow (``_chosen_rows_solve``)."""
-    m, nu = G.shape[0], G.shape[1]
-    if keep < 0:
-        x = np.linalg.lstsq(G, rhs, RANK_TOLERANCE)[0]
-        for k in range(nu):
-            du[k] = x[k]
-        return 1.0
-    return _min_norm_pivoted(G, rhs, keep, du, info, np.empty(m * m + 3 * m))
-
-
-@njit(**UNCOUNTED)
-def _min_norm_pivoted(G, rhs, keep, du, info, work):
-    """``min_norm_step`` with the rank known, in ``work`` (``m^2 + 3 m`` floats)."""
-    m, nu = G.shape[0], G.shape[1]
-    A = c_view(work, 0, (m, m))
-    perm, z, x = (c_view(work, m * m, (m,)), c_view(work, m * m + m, (m,)),
-                  c_view(work, m * m + 2 * m, (m,)))
-    for i in range(m):
-        for j in range(i + 1):
-            acc = 0.0
-            for k in range(nu):
-                acc += G[i, k] * G[j, k]
-            A[i, j] = acc
-            A[j, i] = acc
-    rank = _pivoted_cholesky(A, keep, perm)
-    info[ROWS] = rank
-    for i in range(rank):
-        info[ROWS + 1 + i] = perm[i]
-    _pivoted_back(A, perm, rank, rhs, z, x)
-    for k in range(nu):
-        acc = 0.0
-        for i in range(m):
-            acc += G[i, k] * z[i]
-        du[k] = acc
-    return A[rank - 1, rank - 1] / A[0, 0] if rank else 1.0
 
 
 @njit(cache=True, _nrt=True)   # allocates: counted even under an uncounted caller

@@ -315,6 +315,11 @@ def compiled_rhs(model, *, rebuild=False):
     compiled on first use, then cached (see the module docstring)."""
     from .derive import _as_model, derive
     model = _as_model(model)
+    if getattr(model, "flexible_bodies", ()):
+        raise ModelError(f"model {model.name!r}: the generated right-hand side does not "
+                         f"take flexible bodies ({', '.join(model.flexible_bodies)}); use a "
+                         "numeric method (method='auto'); mb.derive (mbdyn eom) writes "
+                         "their equations")
     if getattr(model, "loop_joints", ()):
         raise ModelError(f"model {model.name!r}: its loop joints ({', '.join(model.loop_joints)}) "
                          "close kinematic loops, and the generated right-hand side solves "

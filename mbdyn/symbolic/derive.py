@@ -40,12 +40,7 @@ FINISH_BUDGET = 5000
 
 
 def _as_model(model_or_system):
-    model = _model_of(model_or_system)
-    if getattr(model, "flexible_bodies", ()):
-        raise ModelError(f"model {model.name!r}: the symbolic layer does not know flexible "
-                         f"bodies ({', '.join(model.flexible_bodies)}) yet; use a numeric "
-                         "method (method='auto'), or switch their flexibility off")
-    return model
+    return _model_of(model_or_system)
 
 
 def _model_of(model_or_system):
@@ -145,6 +140,7 @@ class Derivation:
         """``{name: Symbol}`` of every parameter, coordinate, speed, rate and ``t`` (and
         multiplier, for a closed mechanism)."""
         out = dict(self.walk.sym.table)
+        out.update((s.name, s) for s in self.walk.constants)   # flexible bodies' invariants
         if self.constraints is not None:
             out.update((s.name, s) for s in self.constraints.multipliers)
         return out
@@ -156,7 +152,7 @@ class Derivation:
         plain symbol is not equal to, so ``mass_matrix.subs({Symbol("theta2"): 0})`` would
         change nothing; this method maps by name, and refuses unknown names."""
         import dataclasses
-        table = self.walk.sym.table
+        table = {**self.walk.sym.table, **{s.name: s for s in self.walk.constants}}
         mapping = {}
         for key, value in dict(values).items():
             name = key if isinstance(key, str) else getattr(key, "name", None)
@@ -206,6 +202,7 @@ class Derivation:
             vals.update({s: float(x) for s, x in zip(sym.u, u)})
             p = dict(params, **(parameters or {}))
             vals.update({s: float(p[n]) for n, s in sym.params.items()})
+            vals.update(self.walk.constants)         # flexible bodies' invariants
             if lam and multipliers is None and what in ("accelerations", "reactions"):
                 raise ModelError(f"model {self.model.name!r}: its {what} hold the loop "
                                  "joints' multipliers; pass multipliers=... "

@@ -86,6 +86,13 @@ def jourdain(walk):
                     continue
                 val = m.mass * (m.JT[:, a].T * m.JT[:, b])[0] + (m.JR[:, a].T * IJ[b])[0]
                 Mraw[(a, b)] = Mraw.get((a, b), 0) + val
+    for body in walk.flexible:              # floating-frame bodies: B^T M_b B, B^T Q
+        Mb, fb = body.jourdain()
+        for a in range(nu):
+            f[a] += fb[a]
+            for b in range(a, nu):
+                if Mb[a, b] != 0:
+                    Mraw[(a, b)] = Mraw.get((a, b), 0) + Mb[a, b]
     M = _symmetric({k: s(v) for k, v in Mraw.items()}, nu)
     return Equations("jourdain", M, sympy.Matrix(nu, 1, [s(e) for e in f]),
                      {"effective_loads": per_body})
@@ -134,6 +141,8 @@ def newton_euler(walk):
         bF = m.mass * aG0 - m.force
         AM = I * m.JR + _cross_columns(c, AF)
         bM = I * al0 + cross(m.omega, I * m.omega) - m.moment + cross(c, bF)
+        if m.name in walk.flexible_by_frame:     # a floating frame's rigid rows
+            AF, bF, AM, bM = walk.flexible_by_frame[m.name].wrench(m)
         child_terms = []
         for ch in m.children:
             cAF, cbF, cAM, cbM = wrench[ch.name]
@@ -161,6 +170,9 @@ def newton_euler(walk):
             dM = m.w_rel_basis.applyfunc(lambda e: diff(e, u))
             rows[sym.u.index(u)] = (dF.T * AF + dM.T * AM, (dF.T * bF)[0] + (dM.T * bM)[0])
     bodies.reverse()
+    for body in walk.flexible:              # and its modal rows
+        for r, a, b in body.modal_rows():
+            rows[r] = (a, b)
     M = sympy.zeros(nu, nu)
     f = sympy.zeros(nu, 1)
     for r, (a, b) in rows.items():
@@ -232,6 +244,10 @@ def lagrange(walk):
         for name, F, N, point in m.loads:
             JTp, JR = walk.point_jacobians(m, point)
             Q += JTp.T * F + JR.T * N
+    for body in walk.flexible:              # 1/2 w^T M_b w, weight and strain, the rest
+        Tb, Vb, Qb = body.energies()
+        Tkin, V, Q = Tkin + Tb, V + Vb, Q + Qb
+        parts.append((body.name, Tb, Vb))
     Tkin, V = s(Tkin), s(V)
     Q = Q.applyfunc(s)
     n = len(u)

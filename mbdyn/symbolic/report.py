@@ -10,7 +10,10 @@ JSON (``mbdyn eom --format json``) is one object::
                      "constraint_forces": [str], "equations": str} | null,
      "stats": {"derive_s": float, "operations": int, "operations_after_cse": int}}
 
-(``constraints``: a closed mechanism's loops, ``mbdyn.symbolic.loop_report``.)
+(``constraints``: a closed mechanism's loops, ``mbdyn.symbolic.loop_report``;
+and, only for a model with flexible bodies, ``"flexible"``: ``{body: {"modal_coordinates",
+"equations", "first_moment", "inertia", "coupling", "matrices", "values": {name:
+value}}}``, their invariants as named symbols, ``mbdyn.symbolic.flexible_report``.)
 
 (plus ``"steps"`` when asked for).  Every expression string is ``str()`` of a sympy
 expression: ``sympy.sympify(s, locals={name: Symbol(name) for name in names})`` reads it back,
@@ -20,7 +23,7 @@ from __future__ import annotations
 
 import sympy
 
-from . import loop_report
+from . import flexible_report, loop_report
 from .steps import Step
 
 
@@ -58,6 +61,7 @@ def latex_names(d):
             if n.endswith(suffix) and len(n) > len(suffix):
                 names[s] = acc + "{" + sympy.latex(sympy.Symbol(n[:-len(suffix)])) + "}"
                 break
+    names.update(flexible_report.latex_names(d))
     return names
 
 
@@ -104,6 +108,7 @@ def as_text(d, steps=False):
             out.append(f"  f[{s}] = {_str(d.forcing[r])}")
         out.append("")
         out.extend(loop_report.text_lines(d, _str))
+        out.extend(flexible_report.text_lines(d, _str))
         if d.accelerations is not None:
             if d.constraints is not None:
                 out.append("Accelerations in terms of the multipliers (u' = M^-1 (f + G^T "
@@ -149,6 +154,8 @@ def _latex_body(d, steps, heading, math_open, math_close, para):
         out.append(math_open + "f = " + _latex(d.forcing, names) + math_close)
         out.extend(loop_report.latex_parts(d, names, _latex, heading, math_open, math_close,
                                            para))
+        out.extend(flexible_report.latex_parts(d, names, _latex, heading, math_open,
+                                               math_close, para))
         if d.accelerations is not None:
             out.append(heading("Accelerations"))
             for s, e in d.accelerations.items():
@@ -223,6 +230,8 @@ def as_dict(d, steps=False):
                   "operations": int(d.stats.get("operations", -1)),
                   "operations_after_cse": int(d.stats.get("operations_after_cse", -1))},
     }
+    if d.walk.flexible:                 # a model with flexible bodies: their invariants
+        out["flexible"] = flexible_report.as_dict(d, _str)
     if steps:
         out["steps"] = [_step_dict(st) for st in d.steps()]
     return out

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import sympy
 
+from .flexible_report import flexible_step
 from .loop_steps import constraint_entries, multiplier_step
 from .method_steps import _jourdain_steps, _lagrange_steps, _newton_euler_steps
 from .method_steps import newton_euler_equations, reaction_symbols  # noqa: F401 (their home)
@@ -44,6 +45,9 @@ def build_steps(d):
     c = _Labels(d)
     steps = [step(c) for step in KINEMATIC_STEPS]
     constraint_entries(steps[2], d)         # step 3: a closed mechanism's constraints
+    flexible = flexible_step(d)             # a floating frame's terms, its invariants
+    if flexible is not None:
+        steps.append(flexible)
     if d.method == "newton-euler":
         steps.extend(_newton_euler_steps(d, c.fl, c.basis))
     elif d.method == "jourdain":

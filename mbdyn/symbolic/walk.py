@@ -32,6 +32,8 @@ import numpy as np
 import sympy
 
 from ..errors import ModelError
+from .flexible import attach as attach_flexible
+from .flexible import check as check_flexible
 from .force_elements import apply_forces, reflected_inertia
 from .frames import (FrameMotion, _cross_columns, _joint_values, joint_motion,
                      quaternion_rates)
@@ -71,8 +73,7 @@ class Walk:
         if frames not in FRAMES:
             raise ModelError(f"unknown frames {frames!r}; use one of {', '.join(FRAMES)}")
         if getattr(model, "flexible_bodies", ()):
-            raise ModelError(f"model {model.name!r}: the symbolic layer does not know "
-                             f"flexible bodies ({', '.join(model.flexible_bodies)}) yet")
+            check_flexible(model)           # before any work: what it cannot write
         self.model = model
         self.frames = frames
         self.simplify = simplify
@@ -119,6 +120,7 @@ class Walk:
                 self.by_name[joint.parent].children.append(m)
         self._apply_loads()
         apply_forces(self)
+        attach_flexible(self)               # flexible bodies' terms (``symbolic.flexible``)
 
     # ------------------------------------------------------------------ helpers
     def s(self, expr):
