@@ -93,6 +93,11 @@ def extended_terms(model, qx, ux, t=0.0):
     ``M_x`` plus the stiffening's part in the accelerations (the same array without)."""
     tree = model.tree
     nqt, nut, nux = tree.nq, tree.nu, model._nux
+    f_elements = None
+    if model._flex_elements and not tree.gyroscopic:
+        # the elements read the true velocities, which the bias pass below drops
+        tree._kinematics_kernel(qx[:nqt], ux[:nut], t)
+        f_elements = generalized_forces(model, qx, ux, t)
     tree._jourdain_terms(qx[:nqt], ux[:nut], t)
     M = np.zeros((nux, nux))
     f = np.zeros(nux)
@@ -112,7 +117,7 @@ def extended_terms(model, qx, ux, t=0.0):
         if model.stiffening and fb.axial.any():
             coupled.append((fb.u, np.outer(fb.axial @ eta, B[0])))
     if model._flex_elements:
-        f += generalized_forces(model, qx, ux, t)
+        f += generalized_forces(model, qx, ux, t) if f_elements is None else f_elements
     A = M
     if coupled:
         A = M.copy()

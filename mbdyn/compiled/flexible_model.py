@@ -18,10 +18,12 @@ import numpy as np
 
 from ..algorithms import flexible_dynamics as flex
 from ..algorithms import flexible_forces
+from ..algorithms import flexible_kernels as compiled
 from ..algorithms import flexible_loops as flex_loops
 from ..algorithms import flexible_newton_euler as flex_ne
 from ..algorithms import flexible_reactions as flex_reactions
 from ..errors import ModelError
+from .flexible_packing import FlexibleKernels
 from .flexible_states import remapped_layout, state_map
 from .model import Model
 
@@ -121,6 +123,8 @@ class FlexibleModel(Model):
         self.forces = tree.forces + tuple(el.name for el in forces)
         self._force_elements = tree._force_elements + tuple(forces)
         self._flex_elements = flexible_forces.pack(self, loads, forces)
+        #: the arrays of the compiled evaluations and loops (``kernels.flexible``)
+        self._kernels = FlexibleKernels(self)
 
     def _extended(self, q, u=None):
         """``(q_x, u_x)``: the tree's state then the modal one (``compiled.
@@ -176,8 +180,30 @@ class FlexibleModel(Model):
 
     @property
     def has_callable_loads(self):
-        """True: the flexible bodies' terms are Python, so runs take the Python routes."""
-        return True
+        """True when some load is a Python function (the tree's, or one at a flexible
+        body's point), or the flexible bodies' terms are numpy's (``compiled_terms``
+        off, the default; or contacts between shapes): runs then take the Python
+        routes."""
+        return (self.tree.has_callable_loads or bool(self._kernels.load_functions)
+                or not self._kernels.supported)
+
+    @property
+    def compiled_terms(self):
+        """True when the flexible bodies' terms (``u'``, ``M``, ``f``, the multipliers,
+        the projection) are evaluated by the compiled function and runs take the
+        compiled loops (``algorithms.flexible_kernels``); False (the default): by numpy
+        (``flexible_dynamics``, ``flexible_loops``) and scipy's or the Python loops.
+        Opt-in: its first use compiles for 20 to 30 s of CPU per kind of model
+        (without or with loops, force elements), once per installation (numba's cache);
+        ``docs/flexible.md``, "Routes and cost"."""
+        return self._kernels.supported
+
+    @compiled_terms.setter
+    def compiled_terms(self, on):
+        if on and not self._kernels.takes:
+            raise ModelError(f"model {self.name!r}: the compiled flexible terms do not take "
+                             "contacts between shapes; keep compiled_terms = False")
+        self._kernels.opted = bool(on)
 
     @property
     def flexible_forces(self):
@@ -192,15 +218,13 @@ class FlexibleModel(Model):
 
     def forward_dynamics(self, q, u, t=0.0, method="jourdain"):
         """``u'``: of ``M u' = f``, or with loops of ``M u' = f + G^T lam``,
-        ``G u' = gamma`` (``algorithms.flexible_loops``); ``"newton-euler"`` (or
-        ``"-dense"``): the system with reaction unknowns (``algorithms.
-        flexible_newton_euler``)."""
+        ``G u' = gamma`` (``algorithms.flexible_kernels``: compiled with
+        ``compiled_terms``, else numpy's ``flexible_dynamics``, ``flexible_loops``);
+        ``"newton-euler"`` (or ``"-dense"``): the system with reaction unknowns
+        (``algorithms.flexible_newton_euler``)."""
         if method in flex_ne.METHODS:
             return flex_ne.forward_dynamics(self, q, u, t)
-        if self.has_loops:
-            self.formulation(method)
-            return flex_loops.constrained_accelerations(self, q, u, t)[0]
-        return flex.forward_dynamics(self, q, u, t, method)
+        return compiled.forward_dynamics(self, q, u, t, method)
 
     def formulation(self, method="auto"):
         """``"jourdain"`` for ``"auto"`` and ``"jourdain"``, the Newton-Euler routes as
@@ -269,18 +293,18 @@ class FlexibleModel(Model):
         return self.tree.load_power(*self._tree_state(q, u)[:2], t) + \
             flex.element_energies(self, q, u, t)[2]
 
-    state_derivative = flex.state_derivative
+    state_derivative = compiled.state_derivative
     coordinate_rates = flex.coordinate_rates
-    mass_matrix = flex.mass_matrix
-    forcing = flex.forcing
+    mass_matrix = compiled.mass_matrix
+    forcing = compiled.forcing
     energy = flex.energy
     momentum = flex.momentum
     mass_matrix_condition = flex.mass_matrix_condition
     _check_at_rest = flex.check_at_rest
     constraint_residuals = flex_loops.constraint_residuals
     constraint_jacobian = flex_loops.constraint_jacobian
-    multipliers = flex_loops.multipliers
-    project = flex_loops.project
+    multipliers = compiled.multipliers
+    project = compiled.project
 
     reactions = flex_reactions.reactions
     reaction_uniqueness = flex_reactions.reaction_uniqueness
@@ -294,7 +318,12 @@ class FlexibleModel(Model):
     inverse_dynamics = _not_yet("inverse_dynamics")
     inverse_dynamics_along = _not_yet("inverse_dynamics_along")
     lowlevel = _not_yet("the low-level compiled entry")
-    loop_arguments = _not_yet("the compiled loops")
+
+    def loop_arguments(self, method="jourdain"):
+        """The arrays the compiled loops take (``Model.loop_arguments``), laid out for
+        the flexible bodies' route (``kernels.routes``)."""
+        self.formulation(method)
+        return self._kernels.loop_arguments(self)
 
 
 def _outer_load_functions(model):

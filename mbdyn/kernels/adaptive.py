@@ -388,7 +388,7 @@ def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_s
             if dv.shape[0]:
                 drive_values(ops, consts, starts, t_new, stack, dv)
             st = finish_step(y_new, dv, nq, slots, quats, free_q, free_u, drive_q, drive_u,
-                             tree, ws)
+                             tree, loads, ws)
             if st == 0:
                 st = stage(t_new, y_new, ops, consts, starts, stack, dv, nq, slots, free_q,
                             free_u, drive_q, drive_u, tree, body, loads, ws, K[stages - 1],

@@ -181,7 +181,7 @@ def euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, dr
         if dout.shape[0]:
             _copy(k1, dout[n])              # y' at the step's start, for dense output
         st = finish_step(out[n + 1], drive_table[n][2], nq, slots, quats, free_q, free_u,
-                         drive_q, drive_u, tree, ws)
+                         drive_q, drive_u, tree, loads, ws)
         if st:
             return n, st
         if check_events and step_ends_stretch(events, times[n], out[n + 1], n):
@@ -207,7 +207,7 @@ def semi_implicit_euler_loop(h, y0, drive_table, nq, slots, quats, free_q, free_
         if dout.shape[0]:
             _copy(k1, dout[n])              # y' at the step's start, for dense output
         st = finish_step(out[n + 1], drive_table[n][2], nq, slots, quats, free_q, free_u,
-                         drive_q, drive_u, tree, ws)
+                         drive_q, drive_u, tree, loads, ws)
         if st:
             return n, st
         if check_events and step_ends_stretch(events, times[n], out[n + 1], n):
@@ -232,7 +232,7 @@ def rk4_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u, drive_q, driv
         if dout.shape[0]:
             _copy(k1, dout[n])              # y' at the step's start, for dense output
         st = finish_step(out[n + 1], drive_table[n][2], nq, slots, quats, free_q, free_u,
-                         drive_q, drive_u, tree, ws)
+                         drive_q, drive_u, tree, loads, ws)
         if st:
             return n, st
         if check_events and step_ends_stretch(events, times[n], out[n + 1], n):
@@ -258,7 +258,7 @@ def implicit_midpoint_loop(h, y0, drive_table, nq, slots, quats, free_q, free_u,
         if dout.shape[0]:
             _copy(k1, dout[n])              # y' at the step's start, for dense output
         st = finish_step(out[n + 1], drive_table[n][2], nq, slots, quats, free_q, free_u,
-                         drive_q, drive_u, tree, ws)
+                         drive_q, drive_u, tree, loads, ws)
         if st:
             return n, st
         if check_events and step_ends_stretch(events, times[n], out[n + 1], n):

@@ -14,6 +14,8 @@ from numba.extending import overload
 
 from .constrained import constrained_accelerations, project_state_call
 from .evaluate import articulated_accelerations, jourdain_accelerations
+from .flexible_entry import ACCEL, PROJECT
+from .flexible_views import FUNCTION, call_address
 from .loop_articulated import constrained_articulated
 
 
@@ -42,7 +44,10 @@ def _accelerations_route(tree, body, loads, ws, ud):
     the articulated bodies (``loop_articulated``).  A run compiles only its own route.  A closed
     mechanism's accelerations are inlined here too (a call with their fifty arrays cost a
     tenth of a four-bar's evaluation); the kernels they call that allocate are counted
-    explicitly (``constraint_rows``, the solves)."""
+    explicitly (``constraint_rows``, the solves).  A model with flexible bodies takes the
+    Jourdain layout (with loops, the closed mechanism's) and a *hook* for the loads'
+    ``switches``: its evaluation's address and arrays (``kernels.flexible_entry``), called
+    instead of the tree's."""
     if len(ws) == 29:
         def articulated_loop_route(tree, body, loads, ws, ud):
             (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S, F, N, IA, pA, cb, U, Dl,
@@ -55,6 +60,9 @@ def _accelerations_route(tree, body, loads, ws, ud):
         return articulated_loop_route
     if len(ws) == 26:
         def constrained_route(tree, body, loads, ws, ud):
+            hook = loads[7]
+            if hook.shape[0] > 1:          # flexible bodies (kernels.flexible_entry)
+                return call_address(hook[FUNCTION], hook, ud, ACCEL)
             (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S, F, N, M, f, L,
              scratch) = ws[:18]
             return constrained_accelerations(tree, body, (qfull, ufull, udfull), loads,
@@ -63,6 +71,9 @@ def _accelerations_route(tree, body, loads, ws, ud):
         return constrained_route
     if len(ws) == 18:
         def jourdain_route(tree, body, loads, ws, ud):
+            hook = loads[7]
+            if hook.shape[0] > 1:          # flexible bodies (kernels.flexible_entry)
+                return call_address(hook[FUNCTION], hook, ud, ACCEL)
             (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S, F, N, M, f, L,
              scratch) = ws
             return jourdain_accelerations(tree, body, (qfull, ufull, udfull), loads,
@@ -94,7 +105,8 @@ def _constraints_and_scratch_layout(ws):
     return lambda ws: (ws[18:], ws[17])  # the mass matrix: 18 arrays, then the eight
 
 
-def finish_step(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_u, tree, ws):
+def finish_step(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_u, tree, loads,
+                ws):
     """After a step: unit quaternions and, for a closed mechanism, the state projected
     back onto the constraint manifold (``kernels.constrained.project_state``) with the
     drives at the step's end ``drive_vals``.  Returns 0, or 5 when the projection failed."""
@@ -103,19 +115,24 @@ def finish_step(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_
 
 @overload(finish_step, jit_options={"_nrt": False})
 def _finish_step_route(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_u,
-                       tree, ws):
+                       tree, loads, ws):
     """Chosen by the workspace's layout, as ``accelerations``: a tree only normalises; a
     closed mechanism's projection is the entry point Python calls
-    (``constrained.project_state_call``, counted: it allocates), once a step."""
+    (``constrained.project_state_call``, counted: it allocates), once a step; with
+    flexible bodies (a hook, as in ``accelerations``) their projection
+    (``flexible_loops.project_flexible``)."""
     if len(ws) == 26 or len(ws) == 29:
         def project_route(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_u,
-                          tree, ws):
+                          tree, loads, ws):
             qfull, ufull, udfull = ws[0], ws[1], ws[2]
             for d in range(drive_q.shape[0]):
                 qfull[drive_q[d]] = drive_vals[d, 0]
                 ufull[drive_u[d]] = drive_vals[d, 1]
                 udfull[drive_u[d]] = drive_vals[d, 2]
             _normalize(y, quats)
+            hook = loads[7]
+            if hook.shape[0] > 1:
+                return 5 if call_address(hook[FUNCTION], hook, y, PROJECT) < 0 else 0
             con, scratch = _constraints_and_scratch(ws)
             steps = project_state_call(y, nq, slots, quats, free_q, free_u, tree,
                                        (qfull, ufull, udfull), ws[3:14], con, scratch)
@@ -123,7 +140,7 @@ def _finish_step_route(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q,
         return project_route
 
     def normalize_route(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_u,
-                        tree, ws):
+                        tree, loads, ws):
         _normalize(y, quats)
         return 0
     return normalize_route

@@ -29,6 +29,9 @@ def batchable(scene, quantities):
         return "the model has Euler-angle joints (their singularity is checked per step)"
     if model.has_callable_loads:
         return "the model has Python-function loads"
+    if getattr(model, "compiled_terms", False):
+        return ("the model's compiled flexible terms have one workspace, which members on "
+                "threads would share")
     # "events" has no columns here: a model with events was refused above
     bad = [q for q in quantities
            if q not in ("final", "t_final", "steps", "rhs_evaluations", "events")]
