@@ -136,24 +136,33 @@ def project(model, q, u, t=0.0):
                                   model._free_u, tree, state, motion, model._con,
                                   model._scratch)
     if steps < 0:
-        phi = model._con[2]
-        k = int(np.argmax(np.abs(phi)))
-        raise SimulationError(f"model {model.name!r}, t={t:.6g}: the loops cannot be closed "
-                              f"near this state (constraint {model.constraint_rows[k]} "
-                              f"residual {phi[k]:.3g} after "
-                              f"{kc.PROJECTION_ITERATIONS} Newton steps)")
+        raise positions_not_closed(model, t, model._con[2])
     q, u = y[:model.nq].copy(), y[model.nq:].copy()
     _evaluate(model, q, u, t)
     psi = model._con[3]
     scale = 1.0 + float(np.abs(y[model.nq:]).max(initial=0.0))
     if np.abs(psi).max(initial=0.0) > 1e-8 * scale:
-        k = int(np.argmax(np.abs(psi)))
-        raise SimulationError(f"model {model.name!r}, t={t:.6g}: the speeds cannot satisfy the "
-                              f"loop joint {model._row_joint[k]!r} (its constraint "
-                              f"{model.constraint_rows[k]} moves at {psi[k]:.3g} per second "
-                              "whatever the free speeds): the drives move it against its "
-                              "constraint -- drive fewer joints of the loop")
+        raise speeds_not_closed(model, t, psi)
     return q, u
+
+
+def positions_not_closed(model, t, phi):
+    """The error of a projection whose Newton-Raphson left the residuals ``phi``."""
+    k = int(np.argmax(np.abs(phi)))
+    return SimulationError(f"model {model.name!r}, t={t:.6g}: the loops cannot be closed "
+                           f"near this state (constraint {model.constraint_rows[k]} "
+                           f"residual {phi[k]:.3g} after {kc.PROJECTION_ITERATIONS} Newton "
+                           "steps)")
+
+
+def speeds_not_closed(model, t, psi):
+    """The error of a projection whose speeds keep the constraint rates ``psi``."""
+    k = int(np.argmax(np.abs(psi)))
+    return SimulationError(f"model {model.name!r}, t={t:.6g}: the speeds cannot satisfy the "
+                           f"loop joint {model._row_joint[k]!r} (its constraint "
+                           f"{model.constraint_rows[k]} moves at {psi[k]:.3g} per second "
+                           "whatever the free speeds): the drives move it against its "
+                           "constraint -- drive fewer joints of the loop")
 
 
 def _require_loops(model):

@@ -15,11 +15,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ModelError, NonFiniteError, SimulationError, SingularMassMatrixError
+from ..errors import ModelError, NonFiniteError, SingularMassMatrixError
 from ..kernels import flexible_entry as kfe
-from ..kernels.constrained import PROJECTION_ITERATIONS
 from . import flexible_dynamics as numpy_route
 from . import flexible_loops as numpy_loops
+from .constrained import positions_not_closed, speeds_not_closed
 from .flexible_dynamics import split
 
 
@@ -126,17 +126,6 @@ def multipliers(model, q, u, t=0.0):
     return constrained_accelerations(model, q, u, t)
 
 
-def state_derivative(model, t, y, method="jourdain"):
-    """``[q', u']`` for ``y = [q, u]`` (a new array)."""
-    y = np.asarray(y, dtype=float)
-    if y.shape != (model.nq + model.nu,):
-        raise ModelError(f"model {model.name!r} expects a state of length "
-                         f"{model.nq + model.nu} (q then u), got shape {y.shape}")
-    q, u = y[:model.nq], y[model.nq:]
-    return np.concatenate([model.coordinate_rates(q, u),
-                           model.forward_dynamics(q, u, t, method)])
-
-
 def project(model, q, u, t=0.0):
     """``(q, u)`` moved onto the loop constraints (``flexible_loops.project``), compiled."""
     if not model.has_loops:
@@ -148,18 +137,7 @@ def project(model, q, u, t=0.0):
     steps = _call(model, q, y, kfe.PROJECT, t)
     tree = model.tree
     if steps == -1:
-        phi = tree._con[2]
-        k = int(np.argmax(np.abs(phi)))
-        raise SimulationError(f"model {model.name!r}, t={t:.6g}: the loops cannot be closed "
-                              f"near this state (constraint {model.constraint_rows[k]} "
-                              f"residual {phi[k]:.3g} after {PROJECTION_ITERATIONS} "
-                              "Newton steps)")
+        raise positions_not_closed(model, t, tree._con[2])
     if steps == -2:
-        psi = tree._con[3]
-        k = int(np.argmax(np.abs(psi)))
-        raise SimulationError(f"model {model.name!r}, t={t:.6g}: the speeds cannot satisfy "
-                              f"the loop joint {model._row_joint[k]!r} (its constraint "
-                              f"{model.constraint_rows[k]} moves at {psi[k]:.3g} per second "
-                              "whatever the free speeds): the drives move it against its "
-                              "constraint -- drive fewer joints of the loop")
+        raise speeds_not_closed(model, t, tree._con[3])
     return y[:model.nq].copy(), y[model.nq:].copy()

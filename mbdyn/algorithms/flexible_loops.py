@@ -22,9 +22,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ModelError, NonFiniteError, SimulationError, SingularMassMatrixError
+from ..errors import ModelError, NonFiniteError, SingularMassMatrixError
 from ..kernels.constrained import PROJECTION_ITERATIONS, PROJECTION_TOLERANCE
 from ..kernels.loop_solve import PASSAGE_TOLERANCE, RANK_TOLERANCE
+from .constrained import positions_not_closed, speeds_not_closed
 from .flexible_dynamics import split, terms
 
 #: a projection whose residual stops falling (by half a Newton step) below this is done:
@@ -126,21 +127,12 @@ def project(model, q, u, t=0.0):
         q -= model.coordinate_rates(q, _min_norm(G, phi, model))
         model.normalize_quaternions(q)
     if size > max(PROJECTION_TOLERANCE, STALLED):
-        k = int(np.argmax(np.abs(phi)))
-        raise SimulationError(f"model {model.name!r}, t={t:.6g}: the loops cannot be closed "
-                              f"near this state (constraint {model.constraint_rows[k]} "
-                              f"residual {phi[k]:.3g} after {PROJECTION_ITERATIONS} Newton "
-                              "steps)")
+        raise positions_not_closed(model, t, phi)
     psi = constraint_terms(model, q, u, t)[1]
     u -= _min_norm(G, psi, model)
     psi = constraint_terms(model, q, u, t)[1]
     if np.abs(psi).max(initial=0.0) > 1e-8 * (1.0 + float(np.abs(u).max(initial=0.0))):
-        k = int(np.argmax(np.abs(psi)))
-        raise SimulationError(f"model {model.name!r}, t={t:.6g}: the speeds cannot satisfy "
-                              f"the loop joint {model._row_joint[k]!r} (its constraint "
-                              f"{model.constraint_rows[k]} moves at {psi[k]:.3g} per second "
-                              "whatever the free speeds): the drives move it against its "
-                              "constraint -- drive fewer joints of the loop")
+        raise speeds_not_closed(model, t, psi)
     info = model._con[7]
     if info[2] >= 0:                            # a run: the lowest rank met at its steps
         _, s, _, ratio = _kept(G, model)

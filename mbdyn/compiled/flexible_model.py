@@ -293,7 +293,7 @@ class FlexibleModel(Model):
         return self.tree.load_power(*self._tree_state(q, u)[:2], t) + \
             flex.element_energies(self, q, u, t)[2]
 
-    state_derivative = compiled.state_derivative
+    state_derivative = flex.state_derivative
     coordinate_rates = flex.coordinate_rates
     mass_matrix = compiled.mass_matrix
     forcing = compiled.forcing

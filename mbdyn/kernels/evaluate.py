@@ -9,8 +9,8 @@ allocate nothing and run uncounted (``views.UNCOUNTED``).
 import numpy as np
 from numba import njit
 
-from .articulated import (ARTICULATED_WORK, articulated_body, joint_wrenches_tree,
-                          reaction_components)
+from .articulated import ARTICULATED_WORK, articulated_body
+from .articulated_reactions import joint_wrenches_tree, reaction_components
 from .dynamics import (applied_loads, cholesky_solve, jourdain_terms, jourdain_work,
                        newton_euler_system)
 from .forces import FORCE_WORK, force_elements
@@ -28,6 +28,18 @@ def scratch_size(n, nu, nuf):
                ARTICULATED_WORK + 6 * n)
 
 
+@njit(cache=True, inline="always")
+def outcome(pivot, ud):
+    """A route's return value after its solve: the pivot that failed (>= 0), -2 when
+    ``u'`` came out non-finite, else -1."""
+    if pivot >= 0:
+        return pivot
+    for k in range(ud.shape[0]):
+        if not np.isfinite(ud[k]):
+            return -2
+    return -1
+
+
 @njit(**UNCOUNTED)
 def kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                          mass, com, gravity, qfull, ufull, udfull,
@@ -42,13 +54,9 @@ def kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_
     (``forces.force_elements``)."""
     walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull, ufull,
          udfull, R, r, w, v, alpha, a, JR, JT, S, scratch)
-    applied_loads(mass, com, gravity, R, r, load_body, load_point, load_force, load_moment,
-                  load_in_body, F, N, scratch)
-    if forces is not None:
-        force_int, shapes = forces
-        if force_int.shape[0]:
-            force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w,
-                           v, F, N, force_data[0:0], scratch, shapes)
+    loads_at(parent, axis, mass, com, gravity, qfull, ufull, load_body, load_point,
+             load_force, load_moment, load_in_body, forces, force_data, R, r, w, v, F, N,
+             scratch)
 
 
 @njit(**UNCOUNTED)
@@ -151,12 +159,7 @@ def jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch):
     jourdain_terms(mass, com, inertia, has_inertia, R, r, w, alpha, a, JR, JT, anc_ptr,
                    anc_idx, parent, F, N, M, f, scratch)
     pivot = cholesky_solve(M, f, L, ud)
-    if pivot >= 0:
-        return pivot
-    for k in range(ud.shape[0]):
-        if not np.isfinite(ud[k]):
-            return -2
-    return -1
+    return outcome(pivot, ud)
 
 
 @njit(cache=True)
@@ -214,12 +217,7 @@ def articulated_accelerations(tree, body, state, loads, motion, work, ud, scratc
                                scratch)
     pivot = articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha, a, S, F,
                              N, IA, pA, cb, U, Dl, acc, ud, scratch)
-    if pivot >= 0:
-        return pivot
-    for k in range(ud.shape[0]):
-        if not np.isfinite(ud[k]):
-            return -2
-    return -1
+    return outcome(pivot, ud)
 
 
 @njit(**UNCOUNTED)

@@ -29,7 +29,7 @@ from numba import njit
 
 from .articulated import articulated_body
 from .evaluate import (jourdain_accelerations, motion_and_loads, newton_euler_solution,
-                       newton_euler_tree)
+                       newton_euler_tree, outcome)
 from .forces import ROW
 from .joints import coordinate_rates
 from .views import UNCOUNTED, c_view, far_view, untracked
@@ -333,12 +333,7 @@ def articulated_accelerations_packed(fb, ib, forces, q, u):
     ud = jourdain[3]
     pivot = articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha, a, S, F,
                              N, IA, pA, cb, U, Dl, acc, ud, scratch)
-    if pivot >= 0:
-        return pivot
-    for k in range(ud.shape[0]):
-        if not np.isfinite(ud[k]):
-            return -2
-    return -1
+    return outcome(pivot, ud)
 
 
 @njit(**UNCOUNTED)
