@@ -20,6 +20,8 @@ def _problem(rng, trial):
          else np.zeros((m, nu)))
     if trial % 3 == 0 and m > 1:
         G[1] = G[0]                                   # a repeated row
+    if trial % 4 == 1 and m > 2:                      # rows of zeros (a planar loop's
+        G[rng.choice(m, m // 2, replace=False)] = 0.0  # out-of-plane rows): left out
     A = rng.standard_normal((nu, nu))
     M = A @ A.T + nu * np.eye(nu)
     return M, rng.standard_normal(nu), G, G @ rng.standard_normal(nu)
@@ -28,7 +30,7 @@ def _problem(rng, trial):
 def test_qr_solve_equals_the_minimum_norm_svd_solution():
     """``u'`` and the minimum-norm multipliers by ``pinv`` (numpy's SVD) to 1e-10, the
     rank as numpy counts singular values of ``Y`` above 1e-9 of the largest, on 300
-    random problems of every rank (none, full, redundant, repeated rows)."""
+    random problems of every rank (none, full, redundant, repeated rows, rows of zeros)."""
     rng = np.random.default_rng(7)
     for trial in range(300):
         M, f, G, gamma = _problem(rng, trial)
@@ -80,6 +82,10 @@ def test_packed_entry_takes_any_input_and_names_bad_ones():
     m = scene.model
     q, u = scene.q0.copy(), scene.u0 + 0.1
     ref = m.forward_dynamics(q, u)
+    # from the first call on, the kernel is called frozen, before any check in Python:
+    # its own size check is what refuses a wrong length below
+    assert ("closed", "jourdain") in m._fast_calls
+    assert np.array_equal(m.forward_dynamics(q, u), ref)
     ro = q.copy()
     ro.flags.writeable = False
     strided = np.repeat(q, 2)[::2]
@@ -89,6 +95,8 @@ def test_packed_entry_takes_any_input_and_names_bad_ones():
     assert np.array_equal(m.forward_dynamics(q32, u), m.forward_dynamics(q32.astype(float), u))
     with pytest.raises(ModelError, match="length"):
         m.forward_dynamics(q[:-1], u)
+    with pytest.raises(ModelError, match="length"):
+        m.forward_dynamics(q, np.append(u, 0.0))
 
 
 def _closed_chain(n):
@@ -134,6 +142,9 @@ def test_articulated_route_on_a_long_closed_chain():
     for method in ("jourdain", "newton-euler"):
         other = m.forward_dynamics(q, u, method=method)
         assert np.abs(ud - other).max() <= 1e-9 * np.abs(ud).max(), method
+    assert ("closed", "articulated") in m._fast_calls      # called frozen from now on:
+    with pytest.raises(ModelError, match="length"):       # the kernel checks the sizes
+        m.forward_dynamics(q, u[:-1])
 
 
 @pytest.mark.parametrize("path, case", [("models/andrews_squeezer.toml", None),

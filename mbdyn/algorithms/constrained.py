@@ -15,7 +15,7 @@ from ..errors import ModelError, SimulationError
 from ..kernels import constrained as kc
 from ..kernels import loop_articulated as kla
 from ..kernels.loop_solve import RANK_TOLERANCE
-from .inputs import plain
+from .inputs import freeze, plain
 
 
 def groups(model):
@@ -92,29 +92,51 @@ def constrained_accelerations(model, q, u, t=0.0, route="jourdain"):
     workspace, ``multipliers``) or by the articulated-body algorithm (``"articulated"``,
     O(n) per independent constraint row, multipliers a basic solution; near a singular
     configuration it hands over to the mass matrix).  One compiled call on the packed
-    arrays: float64 arrays as they come, anything else converted and checked first."""
+    arrays: float64 arrays as they come, anything else converted and checked first.
+    After a call that succeeded, a model without inputs written in Python calls the
+    kernel ``frozen`` from then on (``fast_call``), unchecked: numba refuses any other
+    type, the kernel any other size."""
     kernel = (kla.constrained_articulated_packed if route == "articulated"
               else kc.constrained_accelerations_packed)
+    packed = (*model._dynamics_full, *model._con_packed)    # (fb, ib, forces, con_int, cf)
     status = None
     if not model._python_inputs and plain(q, model.nq) and plain(u, model.nu):
         try:
-            status = kernel(*model._packed, *model._con_packed, q, u)
+            status = kernel(*packed, q, u)
         except ZeroDivisionError:
             pass
     if status is None:                           # convert, check, say what is wrong
         q, u = model._fill(q, u, t)
         q, u = np.require(q, float, "CW"), np.require(u, float, "CW")  # one compiled type
         try:
-            status = kernel(*model._packed, *model._con_packed, q, u)
+            status = kernel(*packed, q, u)
         except ZeroDivisionError:
             raise model._division_by_zero(q, t) from None
-    if status == -3:                             # dependent rows: decided with M
+    if status == kla.DEPENDENT_ROWS:             # dependent rows: decided with M
         return constrained_accelerations(model, q, u, t)
     if status >= 0:
         model._raise_singular(q, t, status)
     if status == -2:
         model._check_finite(q, u, t, model._ud, "the accelerations")
+    if status == -1 and not model._python_inputs:
+        freeze(model, ("closed", route), kernel, packed, (q, u), model._ud)
     return model._ud.copy()
+
+
+def fast_call(model, q, u, route):
+    """``u'`` by the frozen kernel of a closed mechanism's ``route`` (``freeze``), or
+    ``None`` when there is none yet, the input is not float64 arrays that fit, or the
+    call did not succeed (the caller then takes the checked route)."""
+    call = model._fast_calls.get(("closed", route))
+    if call is None:
+        return None
+    kernel, fb, ib, forces, con_int, cf, ud = call
+    try:
+        if kernel(fb, ib, forces, con_int, cf, q, u) == -1:
+            return ud.copy()
+    except (TypeError, ZeroDivisionError):
+        pass
+    return None
 
 
 def multipliers(model, q, u, t=0.0):

@@ -12,6 +12,7 @@ from ..errors import ModelError
 from ..kernels import packed as kp
 from .inputs import freeze as _freeze
 from .inputs import plain as _plain
+from .constrained import fast_call as closed_fast_call
 from .constrained import loop_route
 from .loop_newton_euler import loop_newton_euler
 
@@ -46,7 +47,11 @@ def forward_dynamics(model, q, u, t=0.0, method="auto"):
             pass                     # any other input, or a failure: the checked route
     if model._con is not None and method in ("auto", "jourdain", "articulated"):
         # closed loops: G u' = gamma, by the mass matrix or the articulated bodies
-        return model._constrained_accelerations(q, u, t, loop_route(model, method))
+        route = loop_route(model, method)
+        ud = closed_fast_call(model, q, u, route)
+        if ud is not None:
+            return ud
+        return model._constrained_accelerations(q, u, t, route)
     route = model._auto_route if method == "auto" else method
     if model._con is not None and route in ("newton-euler", "newton-euler-dense"):
         return loop_newton_euler(model, q, u, t)[0]

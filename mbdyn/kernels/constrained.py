@@ -21,15 +21,15 @@ runs, whose rank is known, solve on rows instead (``loop_solve``).  When ``M`` i
 import numpy as np
 from numba import njit
 
-from .constraints import (DATA, POINT, ROW_WORK, _constraint_rows, constrained_jacobians,
-                          constraint_rows)
+from .constraints import DATA, POINT, ROW_WORK, _constraint_rows, constraint_rows
 from .evaluate import jourdain_accelerations
 from .joints import coordinate_rates
 from .kinematics import walk
+from .loop_jacobians import constrained_jacobians
 from .loop_solve import (ROWS, augmented_solve, chosen_solve, constrained_solve, rank_of,
                          solve_work)
 from .min_norm import min_norm_step
-from .packed import _scatter, _views
+from .packed import WRONG_SIZE, _scatter, _views
 from .views import UNCOUNTED, c_view, untracked
 
 #: the projection stops when every position residual is below this (metres for points,
@@ -169,7 +169,7 @@ def loop_work(n, nu, m):
     after the tree's kernels (``n`` frames, ``nu`` free speeds, at most ``m`` constraint
     rows), by either route (``loop_articulated.articulated_work``)."""
     return max(ROW_WORK + m * nu, solve_work(nu, m),
-               12 * n + 2 * nu * m + m * m + 5 * m + 6)
+               12 * n + 2 * nu * m + m * m + 6 * m + 6)
 
 
 def con_floats(nprim, m, nu):
@@ -194,11 +194,16 @@ def con_views(con_int, cf, nu):
 
 
 @njit(**UNCOUNTED)
-def constrained_accelerations_packed(fb, ib, t, forces, con_int, cf, q, u):
+def constrained_accelerations_packed(fb, ib, forces, con_int, cf, q, u):
     """Scatter ``q``, ``u``, then ``constrained_accelerations`` on the packed arrays
-    (``kernels.packed``) and the constraints' buffer (``con_views``): the Python entry
-    point of a closed mechanism's forward dynamics and multipliers (same return value;
-    ``u'`` in the ``ud`` view, ``lam`` in the constraints' workspace)."""
+    (``kernels.packed``; the integer buffer stands for the offset table) and the
+    constraints' buffer (``con_views``): the Python entry point of a closed mechanism's
+    forward dynamics and multipliers (same return value, or ``WRONG_SIZE`` for ``q`` or
+    ``u`` of another size; ``u'`` in the ``ud`` view, ``lam`` in the constraints'
+    workspace)."""
+    t = ib
+    if q.shape[0] != t[7] or u.shape[0] != t[1]:
+        return WRONG_SIZE
     _scatter(fb, ib, t, q, u)
     tree, body, state, loads, _, motion, jourdain, _, scratch = _views(fb, ib, t, forces)
     return constrained_accelerations(tree, body, state, loads, motion, jourdain,

@@ -27,7 +27,7 @@ ratio, then the offset.
 import numpy as np
 from numba import njit
 
-from .joints import NU, REVOLUTE
+from .joints import REVOLUTE
 from .linalg3 import cross_to
 from .views import UNCOUNTED, c_view
 
@@ -116,39 +116,6 @@ def _add_rotation_row(G, Gabs, row, i, e, sign, JR):
         term = e[0] * JR[i, 0, col] + e[1] * JR[i, 1, col] + e[2] * JR[i, 2, col]
         G[row, col] += sign * term
         Gabs[row, col] += abs(term)
-
-
-@njit(cache=True, inline="always")
-def jacobian_of(i, parent, kind, ucol, r, S, JR, JT):
-    """``JR[i]``, ``JT[i]`` (3 x nu, world axes): frame ``i``'s angular velocity and its
-    origin's velocity per free speed, from each ancestor joint's motion subspace ``S[k]``
-    (its frame's angular and origin velocity per unit speed) moved to ``O_i``."""
-    for a_ in range(3):
-        for col in range(JR.shape[2]):
-            JR[i, a_, col] = 0.0
-            JT[i, a_, col] = 0.0
-    k = i
-    while k >= 0:
-        if ucol[k] >= 0:
-            d0, d1, d2 = r[i, 0] - r[k, 0], r[i, 1] - r[k, 1], r[i, 2] - r[k, 2]
-            for j in range(NU[kind[k]]):
-                col = ucol[k] + j
-                w0, w1, w2 = S[k, 0, j], S[k, 1, j], S[k, 2, j]
-                JR[i, 0, col], JR[i, 1, col], JR[i, 2, col] = w0, w1, w2
-                JT[i, 0, col] = S[k, 3, j] + w1 * d2 - w2 * d1
-                JT[i, 1, col] = S[k, 4, j] + w2 * d0 - w0 * d2
-                JT[i, 2, col] = S[k, 5, j] + w0 * d1 - w1 * d0
-        k = parent[k]
-
-
-@njit(cache=True, inline="always")
-def constrained_jacobians(con_int, parent, kind, ucol, r, S, JR, JT):
-    """``jacobian_of`` every frame the primitives ``con_int`` join (after kinematics that
-    skipped the full Jacobians: the articulated-body layout)."""
-    for k in range(con_int.shape[0]):
-        for f in (con_int[k, 1], con_int[k, 2]):
-            if f >= 0:
-                jacobian_of(f, parent, kind, ucol, r, S, JR, JT)
 
 
 @njit(cache=True, inline="always")

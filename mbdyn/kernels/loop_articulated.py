@@ -16,25 +16,34 @@ route's).  ``u'`` is unique; ``lam`` is a basic solution (zero on the rows left 
 the minimum-norm one -- reactions take the mass-matrix route (``constrained``).
 
 ``G`` needs the Jacobians of the frames the loop joints join, which the articulated-body
-kinematics do not make (they skip the full Jacobians): ``constraints.constrained_jacobians``
-builds those frames' rows from their ancestors' motion subspaces ``S``, O(depth) each.
+kinematics do not make (they skip the full Jacobians):
+``loop_jacobians.constrained_jacobians`` builds those frames' rows from their ancestors'
+motion subspaces ``S``, O(depth) each.
 """
 import numpy as np
 from numba import njit
 
 from .constrained import con_views
-from .constraints import _constraint_rows, constrained_jacobians
+from .constraints import _constraint_rows
+from .loop_jacobians import constrained_jacobians
 from .evaluate import articulated_accelerations
 from .joints import NU
 from .loop_solve import PASSAGE_TOLERANCE, RANK_TOLERANCE, ROWS
-from .packed import _scatter, _views
+from .packed import WRONG_SIZE, _scatter, _views
 from .rank_qr import pivoted_qr
 from .views import UNCOUNTED, c_view
+
+#: what ``constrained_articulated`` returns outside a run when the rows it chose are
+#: nearly dependent: the caller decides the accelerations with the mass matrix instead
+DEPENDENT_ROWS = -4
 
 
 @njit(cache=True, inline="always")
 def _joint_solve(Dl, i, k, x):
     """``x <- D_i^-1 x``, ``D_i = L L^T`` with ``L`` in ``Dl[i, :k, :k]``."""
+    if k == 1:                                      # most joints: one division
+        x[0] /= Dl[i, 0, 0] * Dl[i, 0, 0]
+        return
     for a_ in range(k):
         s = x[a_]
         for b_ in range(a_):
@@ -143,12 +152,12 @@ def constrained_articulated(tree, body, state, loads, motion, work, ud, con, scr
     docstring); the groups as ``evaluate.articulated_accelerations`` takes them, ``con``
     the constraints' workspace, ``scratch`` sized by ``constrained.loop_work``.  Returns
     -1, the speed where a degree of freedom has no inertia, -2 when ``ud`` holds NaN or
-    Inf, or -3 outside a run when the independent rows are nearly dependent (a singular
-    configuration, which the mass-matrix route decides).  During a run (``info[2]``, the
-    rank it holds), rows that no longer span are chosen again, and near a singular
-    configuration the weakest are dropped for the evaluation: the motion follows its
-    inertia there and the projection after the step puts it back on the constraints, as
-    the mass-matrix route does (``loop_solve.PASSAGE_TOLERANCE``)."""
+    Inf, or ``DEPENDENT_ROWS`` outside a run when the independent rows are nearly
+    dependent (a singular configuration, which the mass-matrix route decides).  During a
+    run (``info[2]``, the rank it holds), rows that no longer span are chosen again, and
+    near a singular configuration the weakest are dropped for the evaluation: the motion
+    follows its inertia there and the projection after the step puts it back on the
+    constraints, as the mass-matrix route does (``loop_solve.PASSAGE_TOLERANCE``)."""
     # long: the rows, the unit solves and the small solve share one scratch layout
     parent, kind, _, _, _, _, qoff, uoff, ucol, _, _ = tree
     qfull, ufull, udfull = state
@@ -174,12 +183,20 @@ def constrained_articulated(tree, body, state, loads, motion, work, ud, con, scr
     res, rows, Rd = (c_view(scratch, at, (m,)), c_view(scratch, at + m, (m,)),
                      c_view(scratch, at + 2 * m, (m,)))
     beta, v6 = c_view(scratch, at + 3 * m, (m,)), c_view(scratch, at + 4 * m, (6,))
-    GT = c_view(scratch, at + 4 * m + 6, (nu, m))
+    index = c_view(scratch, at + 4 * m + 6 + nu * m, (m,))
+    mc = 0                                          # the rows of G that are not all zero
     for i in range(m):
         s = gamma[i]
+        nonzero = False
         for k in range(nu):
             s -= G[i, k] * ud[k]
+            nonzero = nonzero or G[i, k] != 0.0
         res[i] = s
+        if nonzero:
+            index[mc] = i
+            mc += 1
+    # a row of zeros (a planar mechanism's out-of-plane rows) is never chosen: left out
+    GT = c_view(scratch, at + 4 * m + 6, (nu, mc))
     keep = int(info[2])
     chosen = keep >= 0 and info[ROWS] == keep
     for attempt in range(2):
@@ -189,9 +206,11 @@ def constrained_articulated(tree, body, state, loads, motion, work, ud, con, scr
                 rows[j] = info[ROWS + 1 + j]
         else:                                       # the independent rows by QR
             for i in range(nu):
-                for j in range(m):
-                    GT[i, j] = G[j, i]
+                for j in range(mc):
+                    GT[i, j] = G[int(index[j]), i]
             nr = pivoted_qr(GT, RANK_TOLERANCE, rows, Rd, beta)[0]
+            for j in range(nr):
+                rows[j] = index[int(rows[j])]
             if keep >= 0:
                 nr = min(nr, keep)
         for j in range(nr):                         # X_j = M^-1 G_cj^T
@@ -202,7 +221,7 @@ def constrained_articulated(tree, body, state, loads, motion, work, ud, con, scr
         if attempt == 0 and chosen:
             continue                                # those rows no longer span: choose
         if keep < 0:
-            return -3                               # outside a run: the mass matrix decides
+            return DEPENDENT_ROWS                   # outside a run: M decides
         nr = good       # a run near a singular configuration: inertia decides the rest
         break
     for i in range(nr):                             # A y = res_c, y into Rd
@@ -228,10 +247,14 @@ def constrained_articulated(tree, body, state, loads, motion, work, ud, con, scr
 
 
 @njit(**UNCOUNTED)
-def constrained_articulated_packed(fb, ib, t, forces, con_int, cf, q, u):
-    """Scatter ``q``, ``u``, then ``constrained_articulated`` on the packed arrays and the
-    constraints' buffer (the Python entry point of a large closed mechanism; ``u'`` in
-    the ``ud`` view)."""
+def constrained_articulated_packed(fb, ib, forces, con_int, cf, q, u):
+    """Scatter ``q``, ``u``, then ``constrained_articulated`` on the packed arrays (the
+    integer buffer stands for the offset table) and the constraints' buffer (the Python
+    entry point of a large closed mechanism; ``u'`` in the ``ud`` view); ``WRONG_SIZE``
+    for ``q`` or ``u`` of another size."""
+    t = ib
+    if q.shape[0] != t[7] or u.shape[0] != t[1]:
+        return WRONG_SIZE
     _scatter(fb, ib, t, q, u)
     tree, body, state, loads, _, motion, jourdain, art, scratch = _views(fb, ib, t, forces)
     mass, com, inertia, _, gravity = body

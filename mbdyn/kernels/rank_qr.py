@@ -104,22 +104,33 @@ def qr_solve(L, ud, G, gamma, lam, info, tolerance, work):
     minimum-norm multipliers, ``info[0]`` the rank, ``info[1]`` the last kept pivot over
     the first (how far from a singular configuration).  ``work``: ``work_size`` floats."""
     m, nu = G.shape[0], G.shape[1]
-    A, B = c_view(work, 0, (nu, m)), c_view(work, nu * m, (m, m))
     at = nu * m + m * m
     res, perm, Rd, beta = (c_view(work, at, (m,)), c_view(work, at + m, (m,)),
                            c_view(work, at + 2 * m, (m,)), c_view(work, at + 3 * m, (m,)))
-    mu, Ud, beta2, w = (c_view(work, at + 4 * m, (m,)), c_view(work, at + 5 * m, (m,)),
-                        c_view(work, at + 6 * m, (m,)), c_view(work, at + 8 * m, (nu,)))
-    z = c_view(work, at + 8 * m + nu, (nu,))
+    mu, Ud, beta2, index = (c_view(work, at + 4 * m, (m,)), c_view(work, at + 5 * m, (m,)),
+                            c_view(work, at + 6 * m, (m,)), c_view(work, at + 7 * m, (m,)))
+    w, z = c_view(work, at + 8 * m, (nu,)), c_view(work, at + 8 * m + nu, (nu,))
+    mc = 0                                          # the rows of G that are not all zero
     for i in range(m):
         s = gamma[i]
+        nonzero = False
         for k in range(nu):
             s -= G[i, k] * ud[k]
+            nonzero = nonzero or G[i, k] != 0.0
         res[i] = s
         lam[i] = 0.0
-    for j in range(m):                              # L A = G^T, column by column
+        if nonzero:
+            index[mc] = i
+            mc += 1
+    # A row of zeros (a planar mechanism's out-of-plane rows, at every state) is a zero
+    # column of Y: never pivoted in, its multiplier 0 in the minimum-norm solution, and it
+    # adds exact zeros to every other sum: left out, the solution is the same (to rounding:
+    # with no row left out beside them, the multipliers come by back substitution)
+    A, B = c_view(work, 0, (nu, mc)), c_view(work, nu * m, (mc, mc))
+    for j in range(mc):                             # L A = G^T, column by column
+        g = int(index[j])
         for i in range(nu):
-            s = G[j, i]
+            s = G[g, i]
             for k in range(i):
                 s -= L[i, k] * A[k, j]
             A[i, j] = s / L[i, i]
@@ -129,7 +140,7 @@ def qr_solve(L, ud, G, gamma, lam, info, tolerance, work):
     if r == 0:
         return
     for i in range(r):                              # R11^T w = (P^T res)[:r]
-        s = res[int(perm[i])]
+        s = res[int(index[int(perm[i])])]
         for k in range(i):
             s -= A[k, i] * w[k]
         w[i] = s / Rd[i]
@@ -145,9 +156,9 @@ def qr_solve(L, ud, G, gamma, lam, info, tolerance, work):
         z[i] = s / L[i, i]
     for i in range(nu):
         ud[i] += z[i]
-    _min_norm_multipliers(A, Rd, r, m, w, B, Ud, beta2, mu)
-    for i in range(m):
-        lam[int(perm[i])] = mu[i]
+    _min_norm_multipliers(A, Rd, r, mc, w, B, Ud, beta2, mu)
+    for i in range(mc):
+        lam[int(index[int(perm[i])])] = mu[i]
 
 
 @njit(cache=True, inline="always")
