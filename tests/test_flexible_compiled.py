@@ -216,3 +216,18 @@ def test_contacts_between_shapes_keep_numpys_terms():
     with pytest.raises(mb.ModelError, match="contacts between shapes"):
         m.compiled_terms = True
     assert not m.compiled_terms and m.has_callable_loads
+
+
+def test_model_file_key_chooses_the_compiled_terms():
+    """``[model] compiled_terms = true`` (here by ``--set``) sets the flexible model's
+    ``compiled_terms`` (nothing is compiled before a first evaluation); off by default; a
+    warning naming the key on a model without flexible bodies; a value that is not a
+    boolean is refused with the key named."""
+    on = mb.load_model("models/flexible_pendulum.toml",
+                       overrides=["model.compiled_terms=true"])
+    assert on.model.compiled_terms is True
+    assert mb.load_model("models/flexible_pendulum.toml").model.compiled_terms is False
+    with pytest.warns(mb.ModelWarning, match=r"\[model\] compiled_terms.*no flexible"):
+        mb.load_model("models/double_pendulum.toml", overrides=["model.compiled_terms=true"])
+    with pytest.raises(mb.ModelError, match="compiled_terms.*true or false"):
+        mb.load_model("models/flexible_pendulum.toml", overrides=["model.compiled_terms=3"])

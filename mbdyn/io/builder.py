@@ -119,6 +119,20 @@ class SceneBuilder:
         return [read(v, path + (k,)) for k, v in enumerate(value)]
 
     # -- the build
+    def compiled_terms(self, model):
+        """``[model] compiled_terms = true``: the flexible bodies' terms by the compiled
+        function (``FlexibleModel.compiled_terms``); a warning on a model without
+        flexible bodies, the key named where the model cannot take them."""
+        if not hasattr(type(model), "compiled_terms"):
+            warnings.warn(f"{self.file}: [model] compiled_terms: the model has no flexible "
+                          "bodies, whose terms it chooses; it changes nothing here",
+                          ModelWarning)
+            return
+        try:
+            model.compiled_terms = True
+        except ModelError as exc:
+            raise self.error(("model", "compiled_terms"), f"{exc}") from None
+
     def build(self):
         """The ``Scene``'s fields; the warnings met on the way, each once, in ``emitted``
         as ``(message, category)``."""
@@ -135,6 +149,8 @@ class SceneBuilder:
             with self.engine(()):
                 model = system.compile(effects=effects)
             self.model = model
+            if model_table.get("compiled_terms"):
+                self.compiled_terms(model)
             q0, u0, initial = read_initial(self)
             settings = read_simulation(self)
             outputs = read_outputs(self)

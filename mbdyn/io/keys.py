@@ -9,7 +9,9 @@ MODEL_KEYS = {"name": "string", "description": "string", "gravity": "vector",
               "default_case": "string",
               # a URDF robot the file includes (docs/urdf.md)
               "urdf": "string", "floating": "bool", "accept_inertia": "bool",
-              "mesh_path": "paths"}
+              "mesh_path": "paths",
+              # the flexible bodies' terms by the compiled function (docs/flexible.md)
+              "compiled_terms": "bool"}
 BODY_KEYS = {"name": "name", "mass": "expr", "com": "vector", "inertia": "inertia",
              "inertia_about": ("choice", ("com", "origin")), "shape": "shape",
              # a modally reduced flexible body (docs/flexible.md)
