@@ -133,6 +133,14 @@ def test_an_output_that_is_a_folder_is_named_not_its_temporary(case_id, argv, fo
     assert not [n for n in os.listdir(tmp_path / folder.split("/")[0]) if ".tmp" in n]
 
 
+def _default_sigint():
+    """Run in the child before it starts: SIGINT back to its default action.  A suite
+    started in the background by a shell without job control inherits SIGINT ignored,
+    and a Python started with SIGINT ignored keeps ignoring it (no KeyboardInterrupt),
+    so the interruptions below would stop nothing."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 # --- issue 29, item 4: a results pair is all or nothing under SIGINT and SIGTERM
 
 WRITE_TWICE = textwrap.dedent("""\
@@ -165,7 +173,8 @@ def test_a_signal_between_the_renames_of_a_pair_acts_after_both(sig, handler, tm
     out = tmp_path / "out"
     proc = subprocess.Popen([sys.executable, str(script), str(tmp_path / "model.toml"),
                              str(out), handler], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, env=env(), cwd=tmp_path)
+                            stderr=subprocess.PIPE, text=True, env=env(), cwd=tmp_path,
+                            preexec_fn=_default_sigint)
     try:
         assert proc.stdout.readline() == "window\n"
         proc.send_signal(sig)
@@ -235,7 +244,8 @@ def test_an_interrupted_sweep_leaves_no_temporary_folder(tmp_path):
     proc = subprocess.Popen([sys.executable, "-m", "mbdyn", "sweep", "model.toml", "--grid",
                              "parameters.l=0.4:0.5:400", "--out", str(table)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            cwd=tmp_path, env=dict(env(), TMPDIR=str(tmpdir)))
+                            cwd=tmp_path, env=dict(env(), TMPDIR=str(tmpdir)),
+                            preexec_fn=_default_sigint)
     try:
         import time
         deadline = time.monotonic() + 200
@@ -368,7 +378,7 @@ def _start_sweep(tmp_path, table, members=400, extra=()):
     proc = subprocess.Popen([sys.executable, "-m", "mbdyn", "sweep", "model.toml", "--grid",
                              f"parameters.l=0.4:0.5:{members}", "--out", str(table),
                              *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, cwd=tmp_path, env=env())
+                            text=True, cwd=tmp_path, env=env(), preexec_fn=_default_sigint)
     deadline = time.monotonic() + 200
     while time.monotonic() < deadline and proc.poll() is None:
         if table.exists() and len(table.read_text().splitlines()) >= 3:    # 2 rows
