@@ -30,7 +30,7 @@ from .evaluate import articulated_accelerations
 from .joints import NU
 from .loop_solve import PASSAGE_TOLERANCE, RANK_TOLERANCE, ROWS
 from .packed import WRONG_SIZE, _scatter, _views
-from .rank_qr import pivoted_qr
+from .rank_qr import pivoted_qr, residual_rows
 from .views import UNCOUNTED, c_view
 
 #: what ``constrained_articulated`` returns outside a run when the rows it chose are
@@ -184,18 +184,7 @@ def constrained_articulated(tree, body, state, loads, motion, work, ud, con, scr
                      c_view(scratch, at + 2 * m, (m,)))
     beta, v6 = c_view(scratch, at + 3 * m, (m,)), c_view(scratch, at + 4 * m, (6,))
     index = c_view(scratch, at + 4 * m + 6 + nu * m, (m,))
-    mc = 0                                          # the rows of G that are not all zero
-    for i in range(m):
-        s = gamma[i]
-        nonzero = False
-        for k in range(nu):
-            s -= G[i, k] * ud[k]
-            nonzero = nonzero or G[i, k] != 0.0
-        res[i] = s
-        if nonzero:
-            index[mc] = i
-            mc += 1
-    # a row of zeros (a planar mechanism's out-of-plane rows) is never chosen: left out
+    mc = residual_rows(G, gamma, ud, res, index)    # rows of zeros are never chosen
     GT = c_view(scratch, at + 4 * m + 6, (nu, mc))
     keep = int(info[2])
     chosen = keep >= 0 and info[ROWS] == keep

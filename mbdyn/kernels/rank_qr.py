@@ -98,6 +98,28 @@ def pivoted_qr(A, tolerance, perm, Rd, beta):
     return min(rows, cols), first
 
 
+@njit(cache=True, inline="always")
+def residual_rows(G, gamma, ud, res, index):
+    """``res = gamma - G ud``, and in ``index`` the rows of ``G`` that are not all zero
+    (row numbers, as floats); returns how many.  A row of zeros (a planar mechanism's
+    out-of-plane rows, at every state) is a zero column of ``Y``: never pivoted in, its
+    multiplier 0 in the minimum-norm solution, and it adds exact zeros to every other
+    sum, so the solves leave it out."""
+    m, nu = G.shape[0], G.shape[1]
+    mc = 0
+    for i in range(m):
+        s = gamma[i]
+        nonzero = False
+        for k in range(nu):
+            s -= G[i, k] * ud[k]
+            nonzero = nonzero or G[i, k] != 0.0
+        res[i] = s
+        if nonzero:
+            index[mc] = i
+            mc += 1
+    return mc
+
+
 @njit(**UNCOUNTED)
 def qr_solve(L, ud, G, gamma, lam, info, tolerance, work):
     """``ud`` (``M^-1 f`` on entry) corrected to the constrained ``u'``, ``lam`` the
@@ -110,22 +132,11 @@ def qr_solve(L, ud, G, gamma, lam, info, tolerance, work):
     mu, Ud, beta2, index = (c_view(work, at + 4 * m, (m,)), c_view(work, at + 5 * m, (m,)),
                             c_view(work, at + 6 * m, (m,)), c_view(work, at + 7 * m, (m,)))
     w, z = c_view(work, at + 8 * m, (nu,)), c_view(work, at + 8 * m + nu, (nu,))
-    mc = 0                                          # the rows of G that are not all zero
     for i in range(m):
-        s = gamma[i]
-        nonzero = False
-        for k in range(nu):
-            s -= G[i, k] * ud[k]
-            nonzero = nonzero or G[i, k] != 0.0
-        res[i] = s
         lam[i] = 0.0
-        if nonzero:
-            index[mc] = i
-            mc += 1
-    # A row of zeros (a planar mechanism's out-of-plane rows, at every state) is a zero
-    # column of Y: never pivoted in, its multiplier 0 in the minimum-norm solution, and it
-    # adds exact zeros to every other sum: left out, the solution is the same (to rounding:
-    # with no row left out beside them, the multipliers come by back substitution)
+    # the rows of zeros left out: the same solution (to rounding: with no other row left
+    # out, the multipliers come by back substitution)
+    mc = residual_rows(G, gamma, ud, res, index)
     A, B = c_view(work, 0, (nu, mc)), c_view(work, nu * m, (mc, mc))
     for j in range(mc):                             # L A = G^T, column by column
         g = int(index[j])
