@@ -9,7 +9,7 @@ import pytest
 
 import mbdyn as mb
 from mbdyn.errors import ModelError
-from mbdyn.kernels.rank_qr import qr_solve, work_size
+from mbdyn.kernels.rank_qr import WELL_CONDITIONED, _gram_solve, pivoted_qr, qr_solve, work_size
 
 
 def _problem(rng, trial):
@@ -47,6 +47,59 @@ def test_qr_solve_equals_the_minimum_norm_svd_solution():
         sv = np.linalg.svd(Y, compute_uv=False)
         assert info[0] == (np.sum(sv > 1e-9 * sv[0]) if sv.size and sv[0] > 0 else 0)
         assert np.abs(G @ ud - gamma).max() <= 1e-9 * (1 + np.abs(gamma).max())
+
+
+def _conditioned(rng, nu, m, ratio):
+    """``Y`` (nu x m) whose smallest singular value is ``ratio`` of its largest."""
+    U = np.linalg.qr(rng.standard_normal((nu, m)))[0]
+    V = np.linalg.qr(rng.standard_normal((m, m)))[0]
+    return U @ np.diag(np.geomspace(1.0, ratio, m)) @ V.T * rng.uniform(0.1, 10.0)
+
+
+def test_well_conditioned_rows_take_the_normal_equations_and_others_the_qr():
+    """``_gram_solve`` (the pivoted Cholesky of ``Y^T Y``): on independent rows whose
+    conditioning is above ``WELL_CONDITIONED`` it solves, with the same ``u'`` and
+    multipliers as numpy's least squares (1e-12) and the same conditioning figure as
+    the pivoted QR (``info[1]``, 1e-10); below it (or with more rows than speeds) it
+    declines and changes nothing, and ``qr_solve`` still gives the right answer."""
+    rng = np.random.default_rng(37)
+    taken = declined = 0
+    for trial in range(200):
+        nu = int(rng.integers(2, 10))
+        m = int(rng.integers(1, nu + 1))
+        ratio = float(10.0 ** rng.uniform(-4.0, 0.0)) if m > 1 else 1.0
+        A = rng.standard_normal((nu, nu))
+        Lm = np.linalg.cholesky(A @ A.T + nu * np.eye(nu))
+        Y = _conditioned(rng, nu, m, ratio)
+        G = (Lm @ Y).T                                  # Y = L^-1 G^T
+        res = rng.standard_normal(m)
+        ud0 = rng.standard_normal(nu)
+        ud, lam, info = ud0.copy(), np.zeros(m), np.zeros(6 + m)
+        B, perm, w, z = np.empty((m, m)), np.empty(m), np.empty(nu), np.empty(nu)
+        ok = _gram_solve(Y.copy(), m, res, np.arange(m, dtype=float), Lm, ud, lam, info, B,
+                         perm, w, z)
+        sv = np.linalg.svd(Y, compute_uv=False)
+        if not ok:
+            declined += 1
+            assert sv[-1] / sv[0] < 10 * WELL_CONDITIONED, trial
+            assert (ud == ud0).all() and (lam == 0).all() and (info == 0).all()
+            continue
+        taken += 1
+        assert sv[-1] / sv[0] > WELL_CONDITIONED / 10, trial
+        lam_ref = np.linalg.lstsq(Y.T @ Y, res, rcond=None)[0]
+        ud_ref = ud0 + np.linalg.solve(Lm.T, Y @ lam_ref)
+        np.testing.assert_allclose(lam, lam_ref, atol=1e-12 * (1 + np.abs(lam_ref).max()))
+        np.testing.assert_allclose(ud, ud_ref, atol=1e-12 * (1 + np.abs(ud_ref).max()))
+        A, Rd, beta = Y.copy(), np.empty(m), np.empty(m)
+        r, first = pivoted_qr(A, 1e-9, np.empty(m), Rd, beta)
+        assert info[0] == r == m
+        assert abs(info[1] - abs(Rd[r - 1]) / first) <= 1e-10 * info[1], trial
+    assert taken > 50 and declined > 20
+    # more rows than speeds: declined, whatever their conditioning
+    Y = rng.standard_normal((2, 3))
+    assert not _gram_solve(Y, 3, np.ones(3), np.arange(3.0), np.eye(2), np.zeros(2),
+                           np.zeros(3), np.zeros(9), np.empty((3, 3)), np.empty(3),
+                           np.empty(2), np.empty(2))
 
 
 @pytest.mark.parametrize("path, case", [("models/andrews_squeezer.toml", None),

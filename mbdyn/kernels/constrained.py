@@ -23,6 +23,7 @@ from numba import njit
 
 from .constraints import DATA, POINT, ROW_WORK, _constraint_rows, constraint_rows
 from .evaluate import jourdain_accelerations
+from .inverse import jourdain_by_subspaces
 from .joints import coordinate_rates
 from .kinematics import walk
 from .loop_jacobians import constrained_jacobians
@@ -45,11 +46,21 @@ def constrained_accelerations(tree, body, state, loads, motion, jourdain, con, s
     ``(con_int, con_data, phi, psi, G, gamma, lam, info)``.  Returns as
     ``jourdain_accelerations`` (-1 done; a pivot where neither ``M`` nor the augmented
     system determines ``u'``; -2 non-finite)."""
+    pivot = jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch)
+    return close_by_mass_matrix(pivot, tree, state, motion, jourdain, con, scratch)
+
+
+@njit(inline="always")
+def close_by_mass_matrix(pivot, tree, state, motion, jourdain, con, scratch):
+    """The tree's ``M``, ``f``, ``L`` and ``ud = M^-1 f`` (``pivot``, as
+    ``jourdain_accelerations`` returned it) corrected to the closed mechanism's ``u'``:
+    the constraint rows at the state (the Jacobians of the frames they join already in
+    ``JR``, ``JT``), then the rank-tolerant solve.  Returns as
+    ``constrained_accelerations``."""
     M, f, L, ud = jourdain
     R, r, w, v, alpha, a, JR, JT, S, F, N = motion
     qfull, ufull, udfull = state
     con_int, con_data, phi, psi, G, gamma, lam, info = con
-    pivot = jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch)
     # the scratch is free once M and f are made (loop_work: sized for the rows and solves)
     if pivot == -1 and info[2] > 0 and info[ROWS] == info[2]:
         # a run: only the rows its last projection chose, and the solve on them
@@ -169,7 +180,7 @@ def loop_work(n, nu, m):
     after the tree's kernels (``n`` frames, ``nu`` free speeds, at most ``m`` constraint
     rows), by either route (``loop_articulated.articulated_work``)."""
     return max(ROW_WORK + m * nu, solve_work(nu, m),
-               12 * n + 2 * nu * m + m * m + 6 * m + 6)
+               13 * n + 2 * nu * m + m * m + 6 * m + 6)
 
 
 def con_floats(nprim, m, nu):
@@ -197,7 +208,10 @@ def con_views(con_int, cf, nu):
 def constrained_accelerations_packed(fb, ib, forces, con_int, cf, q, u):
     """Scatter ``q``, ``u``, then ``constrained_accelerations`` on the packed arrays
     (``kernels.packed``; the integer buffer stands for the offset table) and the
-    constraints' buffer (``con_views``): the Python entry point of a closed mechanism's
+    constraints' buffer (``con_views``), ``M`` and ``f`` by the motion subspaces as the
+    tree's per-call entries make them (``inverse.jourdain_by_subspaces``, which leaves
+    the full Jacobians out: those of the frames the loops join are made here): the
+    Python entry point of a closed mechanism's
     forward dynamics and multipliers (same return value, or ``WRONG_SIZE`` for ``q`` or
     ``u`` of another size; ``u'`` in the ``ud`` view, ``lam`` in the constraints'
     workspace)."""
@@ -205,6 +219,10 @@ def constrained_accelerations_packed(fb, ib, forces, con_int, cf, q, u):
     if q.shape[0] != t[7] or u.shape[0] != t[1]:
         return WRONG_SIZE
     _scatter(fb, ib, t, q, u)
-    tree, body, state, loads, _, motion, jourdain, _, scratch = _views(fb, ib, t, forces)
-    return constrained_accelerations(tree, body, state, loads, motion, jourdain,
-                                     con_views(con_int, cf, t[1]), scratch)
+    tree, body, state, loads, _, motion, jourdain, art, scratch = _views(fb, ib, t, forces)
+    pivot = jourdain_by_subspaces(tree, body, state, loads, motion, jourdain, art[8], art[2],
+                                  scratch)
+    constrained_jacobians(con_int, tree[0], tree[1], tree[8], motion[1], motion[8],
+                          motion[6], motion[7])
+    return close_by_mass_matrix(pivot, tree, state, motion, jourdain,
+                                con_views(con_int, cf, t[1]), scratch)

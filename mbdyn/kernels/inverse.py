@@ -12,12 +12,15 @@ ordered (angular, linear); a wrench ``(n, f)`` is a moment about ``O_i`` and a f
 * ``composite_mass_matrix_s``: ``M`` by composite rigid bodies (Featherstone's CRBA): the
   inertia of each subtree about its joint's origin, ``F = IC_i S_i`` carried up the
   ancestors, ``M[k, l] = S_k . F``.
+* ``jourdain_by_subspaces``: the Jourdain form's ``M`` and ``f`` by the two, for the
+  per-call entry of a closed mechanism (``f = -tau`` at ``u' = 0``).
 """
 from numba import njit
 
 import numpy as np
 
-from .evaluate import motion_and_loads
+from .dynamics import cholesky_solve
+from .evaluate import motion_and_loads, outcome
 from .joints import NU
 from .motion import cross, motion, row3
 from .packed import FREE_Q, FREE_U, UDFULL, WRONG_SIZE, _scatter, _views
@@ -162,6 +165,28 @@ def _add_about_parent(IC, i, p, x, y, z):
     IC[p, 1, 3] += IC[i, 1, 3] + d - 2.0 * y * hy - m * y * y
     IC[p, 1, 4] += IC[i, 1, 4] - y * hz - hy * z - m * y * z
     IC[p, 1, 5] += IC[i, 1, 5] + d - 2.0 * z * hz - m * z * z
+
+
+@njit(cache=True, inline="always")
+def jourdain_by_subspaces(tree, body, state, loads, kin, jourdain, wrench, IC, scratch):
+    """``M u' = f`` by the motion subspaces ``S`` (no full Jacobians): the kinematics and
+    loads of the per-call entries (``evaluate.motion_and_loads``, the free speeds' rates
+    zero), ``f = -tau`` by ``recursive_newton_euler`` there (the generalized force that
+    would hold the mechanism at ``u' = 0``: gravity, loads, velocity products) and ``M`` by
+    ``composite_mass_matrix_s``; then ``ud = M^-1 f`` by Cholesky.  The groups as
+    ``evaluate.jourdain_accelerations`` takes them (``jourdain``: ``M, f, L, ud``), with
+    ``wrench`` (n x 6) and ``IC`` (n x 6 x 6) for workspace.  Returns as it does."""
+    motion_and_loads(tree, body, state, loads, kin, scratch)
+    mass, com, inertia = body[0], body[1], body[2]
+    parent, kind, ucol = tree[0], tree[1], tree[8]
+    R, r, w, v, alpha, a, _, _, S, F, N = kin
+    M, f, L, ud = jourdain
+    recursive_newton_euler(mass, com, inertia, parent, kind, ucol, R, r, w, alpha, a, S, F, N,
+                           wrench, f, scratch)
+    for k in range(f.shape[0]):
+        f[k] = -f[k]
+    composite_mass_matrix_s(mass, com, inertia, parent, kind, ucol, R, r, S, IC, M, scratch)
+    return outcome(cholesky_solve(M, f, L, ud), ud)
 
 
 # The entries on the packed buffers (``packed``): one compiled call each.

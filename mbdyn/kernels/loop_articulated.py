@@ -23,11 +23,12 @@ motion subspaces ``S``, O(depth) each.
 import numpy as np
 from numba import njit
 
+from .articulated import articulated_body
 from .constrained import con_views
 from .constraints import _constraint_rows
-from .loop_jacobians import constrained_jacobians
-from .evaluate import articulated_accelerations
+from .evaluate import articulated_accelerations, motion_and_loads, outcome
 from .joints import NU
+from .loop_jacobians import constrained_jacobians
 from .loop_solve import PASSAGE_TOLERANCE, RANK_TOLERANCE, ROWS
 from .packed import WRONG_SIZE, _scatter, _views
 from .rank_qr import pivoted_qr, residual_rows
@@ -39,10 +40,11 @@ DEPENDENT_ROWS = -4
 
 
 @njit(cache=True, inline="always")
-def _joint_solve(Dl, i, k, x):
-    """``x <- D_i^-1 x``, ``D_i = L L^T`` with ``L`` in ``Dl[i, :k, :k]``."""
-    if k == 1:                                      # most joints: one division
-        x[0] /= Dl[i, 0, 0] * Dl[i, 0, 0]
+def _joint_solve(Dl, rec, i, k, x):
+    """``x <- D_i^-1 x``, ``D_i = L L^T`` with ``L`` in ``Dl[i, :k, :k]``; ``rec[i]`` holds
+    ``1 / D_i`` of a one-speed joint (``reciprocals``)."""
+    if k == 1:                                      # most joints: one product
+        x[0] *= rec[i]
         return
     for a_ in range(k):
         s = x[a_]
@@ -57,11 +59,30 @@ def _joint_solve(Dl, i, k, x):
 
 
 @njit(cache=True, inline="always")
-def unit_solve(parent, kind, ucol, r, S, U, Dl, tau, x, p, acc, v6):
+def reciprocals(kind, ucol, Dl, rec):
+    """``rec[i] = 1 / D_i`` for every joint of one speed (``D_i = Dl[i, 0, 0]^2``): the
+    unit solves multiply by it, so that no division lies on their sweeps' chain of
+    dependent operations (independent divisions here, pipelined)."""
+    for i in range(kind.shape[0]):
+        if ucol[i] >= 0 and NU[kind[i]] == 1:
+            rec[i] = 1.0 / (Dl[i, 0, 0] * Dl[i, 0, 0])
+
+
+@njit(cache=True, inline="always")
+def _dot6(A, i, j, x, b):
+    """``sum_a A[i, a, j] x[b, a]``, summed in pairs (a shorter chain of dependent adds
+    than one running sum)."""
+    return ((A[i, 0, j] * x[b, 0] + A[i, 1, j] * x[b, 1])
+            + (A[i, 2, j] * x[b, 2] + A[i, 3, j] * x[b, 3])
+            + (A[i, 4, j] * x[b, 4] + A[i, 5, j] * x[b, 5]))
+
+
+@njit(cache=True, inline="always")
+def unit_solve(parent, kind, ucol, r, S, U, Dl, rec, tau, x, p, acc, v6):
     """``x = M^-1 tau`` by the articulated-body factors ``U``, ``Dl`` of the last
-    ``articulated_body`` call: the algorithm's two sweeps for the generalized force
-    ``tau`` alone (no velocities, no gravity, no applied loads).  ``p``, ``acc`` (n x 6)
-    and ``v6`` (6): scratch."""
+    ``articulated_body`` call (and ``rec``, ``reciprocals``): the algorithm's two sweeps
+    for the generalized force ``tau`` alone (no velocities, no gravity, no applied
+    loads).  ``p``, ``acc`` (n x 6) and ``v6`` (6): scratch."""
     n = parent.shape[0]
     for i in range(n):
         for a_ in range(6):
@@ -71,11 +92,8 @@ def unit_solve(parent, kind, ucol, r, S, U, Dl, tau, x, p, acc, v6):
         k = NU[kind[i]] if col0 >= 0 else 0
         if k:
             for j in range(k):
-                s = tau[col0 + j]
-                for a_ in range(6):
-                    s -= S[i, a_, j] * p[i, a_]
-                v6[j] = s
-            _joint_solve(Dl, i, k, v6)
+                v6[j] = tau[col0 + j] - _dot6(S, i, j, p, i)
+            _joint_solve(Dl, rec, i, k, v6)
             for j in range(k):
                 x[col0 + j] = v6[j]                  # D^-1 (tau - S^T p), kept for below
                 for a_ in range(6):
@@ -105,11 +123,8 @@ def unit_solve(parent, kind, ucol, r, S, U, Dl, tau, x, p, acc, v6):
         if col0 >= 0:
             k = NU[kind[i]]
             for j in range(k):
-                s = 0.0
-                for a_ in range(6):
-                    s += U[i, a_, j] * acc[i, a_]
-                v6[j] = s
-            _joint_solve(Dl, i, k, v6)
+                v6[j] = _dot6(U, i, j, acc, i)
+            _joint_solve(Dl, rec, i, k, v6)
             for j in range(k):
                 x[col0 + j] -= v6[j]
                 for a_ in range(6):
@@ -158,15 +173,24 @@ def constrained_articulated(tree, body, state, loads, motion, work, ud, con, scr
     near a singular configuration the weakest are dropped for the evaluation: the motion
     follows its inertia there and the projection after the step puts it back on the
     constraints, as the mass-matrix route does (``loop_solve.PASSAGE_TOLERANCE``)."""
+    pivot = articulated_accelerations(tree, body, state, loads, motion, work, ud, scratch)
+    if pivot != -1:
+        return pivot
+    return close_loops(tree, state, motion, work, ud, con, scratch)
+
+
+@njit(cache=True, inline="always")
+def close_loops(tree, state, motion, work, ud, con, scratch):
+    """``ud``, the tree's ``M^-1 f`` left by the articulated-body algorithm (whose
+    factors ``work`` holds), corrected to the closed mechanism's ``u'``: the rows of the
+    constraints, then the unit solves and the small solve on independent rows.  Returns
+    as ``constrained_articulated``."""
     # long: the rows, the unit solves and the small solve share one scratch layout
-    parent, kind, _, _, _, _, qoff, uoff, ucol, _, _ = tree
+    parent, kind, _, _, _, _, qoff, uoff, ucol = tree[:9]
     qfull, ufull, udfull = state
     R, r, w, v, alpha, a, JR, JT, S, F, N = motion
     U, Dl = work[3], work[4]
     con_int, con_data, phi, psi, G, gamma, lam, info = con
-    pivot = articulated_accelerations(tree, body, state, loads, motion, work, ud, scratch)
-    if pivot != -1:
-        return pivot
     constrained_jacobians(con_int, parent, kind, ucol, r, S, JR, JT)
     _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
                      R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch)
@@ -184,6 +208,8 @@ def constrained_articulated(tree, body, state, loads, motion, work, ud, con, scr
                      c_view(scratch, at + 2 * m, (m,)))
     beta, v6 = c_view(scratch, at + 3 * m, (m,)), c_view(scratch, at + 4 * m, (6,))
     index = c_view(scratch, at + 4 * m + 6 + nu * m, (m,))
+    rec = c_view(scratch, at + 5 * m + 6 + nu * m, (n,))
+    reciprocals(kind, ucol, Dl, rec)
     mc = residual_rows(G, gamma, ud, res, index)    # rows of zeros are never chosen
     GT = c_view(scratch, at + 4 * m + 6, (nu, mc))
     keep = int(info[2])
@@ -203,7 +229,8 @@ def constrained_articulated(tree, body, state, loads, motion, work, ud, con, scr
             if keep >= 0:
                 nr = min(nr, keep)
         for j in range(nr):                         # X_j = M^-1 G_cj^T
-            unit_solve(parent, kind, ucol, r, S, U, Dl, G[int(rows[j])], X[j], p, acc2, v6)
+            unit_solve(parent, kind, ucol, r, S, U, Dl, rec, G[int(rows[j])], X[j], p,
+                       acc2, v6)
         first, good = _schur_cholesky(G, X, rows, nr, A)
         if good == nr:
             break
@@ -239,14 +266,22 @@ def constrained_articulated(tree, body, state, loads, motion, work, ud, con, scr
 def constrained_articulated_packed(fb, ib, forces, con_int, cf, q, u):
     """Scatter ``q``, ``u``, then ``constrained_articulated`` on the packed arrays (the
     integer buffer stands for the offset table) and the constraints' buffer (the Python
-    entry point of a large closed mechanism; ``u'`` in the ``ud`` view); ``WRONG_SIZE``
-    for ``q`` or ``u`` of another size."""
+    entry point of a large closed mechanism; ``u'`` in the ``ud`` view), its kinematics
+    those of the tree's entry (``evaluate.motion_and_loads``); ``WRONG_SIZE`` for ``q`` or
+    ``u`` of another size."""
     t = ib
     if q.shape[0] != t[7] or u.shape[0] != t[1]:
         return WRONG_SIZE
     _scatter(fb, ib, t, q, u)
-    tree, body, state, loads, _, motion, jourdain, art, scratch = _views(fb, ib, t, forces)
+    tree, body, state, loads, _, kin, jourdain, art, scratch = _views(fb, ib, t, forces)
     mass, com, inertia, _, gravity = body
-    return constrained_articulated(tree[:9] + art[:2], (mass, com, inertia, gravity), state,
-                                   loads, motion, art[2:8], jourdain[3],
-                                   con_views(con_int, cf, t[1]), scratch)
+    motion_and_loads(tree, body, state, loads, kin, scratch)
+    R, r, w, v, alpha, a, _, _, S, F, N = kin
+    IA, pA, cb, U, Dl, acc = art[2:8]
+    ud = jourdain[3]
+    pivot = outcome(articulated_body(mass, com, inertia, tree[0], tree[1], tree[8], R, r, w,
+                                     alpha, a, S, F, N, IA, pA, cb, U, Dl, acc, ud, scratch),
+                    ud)
+    if pivot != -1:
+        return pivot
+    return close_loops(tree, state, kin, art[2:8], ud, con_views(con_int, cf, t[1]), scratch)
