@@ -131,3 +131,31 @@ def test_random_closed_mechanism(seed):
         a, b = np.concatenate(r1[joint]), np.concatenate(r2[joint])
         d = np.abs(a - b)[unique[joint]]
         assert d.size == 0 or d.max() <= 1e-10 * (1 + np.abs(a).max()), joint
+
+
+@pytest.mark.parametrize("path, case", [("models/four_bar.toml", "free"),
+                                        ("models/andrews_squeezer.toml", None),
+                                        ("models/bricard.toml", None), (None, 0), (None, 5)])
+def test_rows_left_out_are_zero_at_every_state(path, case):
+    """The primitives the per-call entries leave out (``con_int[:, 5] == 0``,
+    ``constraint_packing.moves``) have rows of ``G`` and ``gamma`` that are exactly zero
+    at random states (off the mechanism too, every coordinate moved), and the planar
+    mechanisms do have such rows (Andrews' squeezer: 6 of its 9 primitives)."""
+    if path is None:
+        model = random_closed(case)[0]
+    else:
+        model = mb.load_model(path, case).model
+    con_int = model._con[0]
+    rows = np.repeat(np.arange(con_int.shape[0]), [3 if k == 0 else 1 for k in con_int[:, 0]])
+    out = np.flatnonzero(con_int[rows, 5] == 0)
+    if path and "bricard" not in path:
+        assert out.size >= 2
+    rng = np.random.default_rng(5)
+    for _ in range(5):
+        q, u = rng.normal(size=model.nq), rng.normal(size=model.nu)
+        if hasattr(model, "_quaternions"):
+            for s in model._quaternions:
+                q[s] /= np.linalg.norm(q[s])
+        G = model.constraint_jacobian(q)
+        model.constraint_residuals(q, u)
+        assert (G[out] == 0).all() and (model._con[5][out] == 0).all()

@@ -47,15 +47,16 @@ def constrained_accelerations(tree, body, state, loads, motion, jourdain, con, s
     ``jourdain_accelerations`` (-1 done; a pivot where neither ``M`` nor the augmented
     system determines ``u'``; -2 non-finite)."""
     pivot = jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch)
-    return close_by_mass_matrix(pivot, tree, state, motion, jourdain, con, scratch)
+    return close_by_mass_matrix(pivot, tree, state, motion, jourdain, con, scratch, False)
 
 
 @njit(inline="always")
-def close_by_mass_matrix(pivot, tree, state, motion, jourdain, con, scratch):
+def close_by_mass_matrix(pivot, tree, state, motion, jourdain, con, scratch, live):
     """The tree's ``M``, ``f``, ``L`` and ``ud = M^-1 f`` (``pivot``, as
     ``jourdain_accelerations`` returned it) corrected to the closed mechanism's ``u'``:
     the constraint rows at the state (the Jacobians of the frames they join already in
-    ``JR``, ``JT``), then the rank-tolerant solve.  Returns as
+    ``JR``, ``JT``), then the rank-tolerant solve; with ``live``, the rows that are zero
+    at every state are not evaluated (``constraints._constraint_rows``).  Returns as
     ``constrained_accelerations``."""
     M, f, L, ud = jourdain
     R, r, w, v, alpha, a, JR, JT, S, F, N = motion
@@ -72,7 +73,7 @@ def close_by_mass_matrix(pivot, tree, state, motion, jourdain, con, scratch):
         info[ROWS] = -1.0            # no longer independent: every row, pivoted, until the
                                      # next projection chooses again
     _constraint_rows(con_int, con_data, tree[8], tree[6], tree[7], qfull, ufull, udfull,
-                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch)
+                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch, None, -1, live)
     if pivot >= 0:
         for k in range(ud.shape[0]):
             ud[k] = f[k]
@@ -225,4 +226,4 @@ def constrained_accelerations_packed(fb, ib, forces, con_int, cf, q, u):
     constrained_jacobians(con_int, tree[0], tree[1], tree[8], motion[1], motion[8],
                           motion[6], motion[7])
     return close_by_mass_matrix(pivot, tree, state, motion, jourdain,
-                                con_views(con_int, cf, t[1]), scratch)
+                                con_views(con_int, cf, t[1]), scratch, True)

@@ -161,11 +161,15 @@ ROW_WORK = 57
 @njit(**UNCOUNTED)
 def _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
                      R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, work, chosen=None,
-                     nchosen=-1):
+                     nchosen=-1, live=False):
     """``constraint_rows`` in the scratch ``work`` (one allocation by the caller: the
     vectors below are views of it, which cost no allocation each).  Given ``chosen``, only
     the primitives holding one of the rows ``chosen[:nchosen]`` (row numbers, as floats)
-    are evaluated, the other rows left zero (a run solves on the rows it last chose)."""
+    are evaluated, the other rows left zero (a run solves on the rows it last chose).
+    With ``live``, the primitives whose rows are zero at every state (``con_int[:, 5]``
+    0: ``compiled.constraint_packing.moves``) are not evaluated: their ``G`` rows and
+    ``gamma`` are zero, their ``phi`` and ``psi`` set to zero too (the accelerations'
+    entries do not read them)."""
     # long: one loop over the primitives, each kind's rows written where they are derived
     # (a reader checks a kind's residual, rate, Jacobian and gamma side by side).
     w0, rp, Pp, vp = (c_view(work, 0, (3,)), c_view(work, 3, (3,)), c_view(work, 6, (3,)),
@@ -188,6 +192,11 @@ def _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
     for m in range(con_int.shape[0]):
         kind, ip, ic = con_int[m, 0], con_int[m, 1], con_int[m, 2]
         if chosen is not None and not _holds_chosen(row, ROWS[kind], chosen, nchosen):
+            row += ROWS[kind]
+            continue
+        if live and con_int[m, 5] == 0:
+            for k in range(ROWS[kind]):
+                phi[row + k] = psi[row + k] = gamma[row + k] = 0.0
             row += ROWS[kind]
             continue
         sp, sc = con_data[m, 0:3], con_data[m, 3:6]

@@ -176,15 +176,16 @@ def constrained_articulated(tree, body, state, loads, motion, work, ud, con, scr
     pivot = articulated_accelerations(tree, body, state, loads, motion, work, ud, scratch)
     if pivot != -1:
         return pivot
-    return close_loops(tree, state, motion, work, ud, con, scratch)
+    return close_loops(tree, state, motion, work, ud, con, scratch, False)
 
 
 @njit(cache=True, inline="always")
-def close_loops(tree, state, motion, work, ud, con, scratch):
+def close_loops(tree, state, motion, work, ud, con, scratch, live):
     """``ud``, the tree's ``M^-1 f`` left by the articulated-body algorithm (whose
     factors ``work`` holds), corrected to the closed mechanism's ``u'``: the rows of the
-    constraints, then the unit solves and the small solve on independent rows.  Returns
-    as ``constrained_articulated``."""
+    constraints (with ``live``, not those zero at every state:
+    ``constraints._constraint_rows``), then the unit solves and the small solve on
+    independent rows.  Returns as ``constrained_articulated``."""
     # long: the rows, the unit solves and the small solve share one scratch layout
     parent, kind, _, _, _, _, qoff, uoff, ucol = tree[:9]
     qfull, ufull, udfull = state
@@ -193,7 +194,7 @@ def close_loops(tree, state, motion, work, ud, con, scratch):
     con_int, con_data, phi, psi, G, gamma, lam, info = con
     constrained_jacobians(con_int, parent, kind, ucol, r, S, JR, JT)
     _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
-                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch)
+                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch, None, -1, live)
     m, nu, n = G.shape[0], G.shape[1], parent.shape[0]
     for i in range(m):
         lam[i] = 0.0
@@ -284,4 +285,5 @@ def constrained_articulated_packed(fb, ib, forces, con_int, cf, q, u):
                     ud)
     if pivot != -1:
         return pivot
-    return close_loops(tree, state, kin, art[2:8], ud, con_views(con_int, cf, t[1]), scratch)
+    return close_loops(tree, state, kin, art[2:8], ud, con_views(con_int, cf, t[1]), scratch,
+                       True)
