@@ -77,7 +77,7 @@ def test_well_conditioned_rows_take_the_normal_equations_and_others_the_qr():
         ud, lam, info = ud0.copy(), np.zeros(m), np.zeros(6 + m)
         B, perm, w, z = np.empty((m, m)), np.empty(m), np.empty(nu), np.empty(nu)
         ok = _gram_solve(Y.copy(), m, res, np.arange(m, dtype=float), Lm, ud, lam, info, B,
-                         perm, w, z)
+                         perm, np.empty(m), w, z)
         sv = np.linalg.svd(Y, compute_uv=False)
         if not ok:
             declined += 1
@@ -98,7 +98,7 @@ def test_well_conditioned_rows_take_the_normal_equations_and_others_the_qr():
     # more rows than speeds: declined, whatever their conditioning
     Y = rng.standard_normal((2, 3))
     assert not _gram_solve(Y, 3, np.ones(3), np.arange(3.0), np.eye(2), np.zeros(2),
-                           np.zeros(3), np.zeros(9), np.empty((3, 3)), np.empty(3),
+                           np.zeros(3), np.zeros(9), np.empty((3, 3)), np.empty(3), np.empty(3),
                            np.empty(2), np.empty(2))
 
 

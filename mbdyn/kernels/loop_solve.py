@@ -12,7 +12,7 @@ semi-definite takes the augmented system by least squares (``augmented_solve``).
 import numpy as np
 from numba import njit
 
-from .rank_qr import qr_solve, work_size
+from .rank_qr import add_back_solved, pivoted_back, qr_solve, work_size
 from .views import UNCOUNTED, c_view
 
 #: pivots of the column-pivoted QR of ``Y = L^-1 G^T`` (which follow its singular values)
@@ -67,13 +67,7 @@ def _add_correction(L, ud, Y, lam, z, m):
         for j in range(m):
             acc += Y[i, j] * lam[j]
         z[i] = acc
-    for i in range(nu - 1, -1, -1):
-        s = z[i]
-        for k in range(i + 1, nu):
-            s -= L[k, i] * z[k]
-        z[i] = s / L[i, i]
-    for i in range(nu):
-        ud[i] += z[i]
+    add_back_solved(L, z, ud)
 
 
 @njit(cache=True, inline="always")
@@ -115,27 +109,6 @@ def _pivoted_cholesky(A, keep, perm):
     return rank
 
 
-@njit(cache=True, inline="always")
-def _pivoted_back(A, perm, rank, rhs, out, x):
-    """``out`` (all rows): the solution of the pivoted rows' system ``L_r L_r^T x =
-    rhs[perm[:rank]]`` at those rows, zero elsewhere (``x``: at least ``rank`` floats of
-    scratch)."""
-    for i in range(rank):
-        s = rhs[int(perm[i])]
-        for k in range(i):
-            s -= A[i, k] * x[k]
-        x[i] = s / A[i, i]
-    for i in range(rank - 1, -1, -1):
-        s = x[i]
-        for k in range(i + 1, rank):
-            s -= A[k, i] * x[k]
-        x[i] = s / A[i, i]
-    for j in range(out.shape[0]):
-        out[j] = 0.0
-    for i in range(rank):
-        out[int(perm[i])] = x[i]
-
-
 @njit(**UNCOUNTED)
 def _pivoted_solve(L, ud, G, gamma, lam, info, keep, work):
     """The constrained ``ud`` during a run, whose rank ``keep`` is known: ``S = Y^T Y``
@@ -158,7 +131,7 @@ def _pivoted_solve(L, ud, G, gamma, lam, info, keep, work):
         perm[j] = j
     first = _schur_rows(L, ud, G, gamma, perm, m, Y, A, res)
     rank = _pivoted_cholesky(A, keep, perm)
-    _pivoted_back(A, perm, rank, res, lam, x)
+    pivoted_back(A, perm, rank, res, lam, x)
     _add_correction(L, ud, Y, lam, z, m)
     info[0] = rank
     info[1] = A[rank - 1, rank - 1] / np.sqrt(first) if rank and first > 0 else 1.0
@@ -234,7 +207,7 @@ def _chosen_rows_solve(L, ud, G, gamma, lam, info, r, Y, A, res, x, z):
             for j in range(k):
                 s -= A[i, j] * A[k, j]
             A[i, k] = s / A[k, k]
-    _pivoted_back(A, rows, r, res, lam, x)          # the rows' multipliers, 0 elsewhere
+    pivoted_back(A, rows, r, res, lam, x)          # the rows' multipliers, 0 elsewhere
     _add_correction(L, ud, Y, x, z, r)
     info[0] = r
     info[1] = A[r - 1, r - 1] / np.sqrt(first) if first > 0 else 1.0

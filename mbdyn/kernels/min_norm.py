@@ -7,7 +7,8 @@ factorisation chose while they stay well conditioned, else chosen again.
 import numpy as np
 from numba import njit
 
-from .loop_solve import RANK_TOLERANCE, ROWS, _pivoted_back, _pivoted_cholesky
+from .loop_solve import RANK_TOLERANCE, ROWS, _pivoted_cholesky
+from .rank_qr import pivoted_back
 from .views import UNCOUNTED, c_view
 
 #: a projection's minimum-norm steps reuse the rows the last pivoted factorisation chose
@@ -121,7 +122,7 @@ def _min_norm_pivoted(G, rhs, keep, du, info, work):
     info[ROWS] = rank
     for i in range(rank):
         info[ROWS + 1 + i] = perm[i]
-    _pivoted_back(A, perm, rank, rhs, z, x)
+    pivoted_back(A, perm, rank, rhs, z, x)
     for k in range(nu):
         acc = 0.0
         for i in range(m):

@@ -158,7 +158,7 @@ def qr_solve(L, ud, G, gamma, lam, info, tolerance, work):
             for k in range(i):
                 s -= L[i, k] * A[k, j]
             A[i, j] = s / L[i, i]
-    if _gram_solve(A, mc, res, index, L, ud, lam, info, B, perm, w, z):
+    if _gram_solve(A, mc, res, index, L, ud, lam, info, B, perm, mu, w, z):
         return
     r, first = pivoted_qr(A, tolerance, perm, Rd, beta)
     info[0] = r
@@ -175,16 +175,46 @@ def qr_solve(L, ud, G, gamma, lam, info, tolerance, work):
     for i in range(nu):
         z[i] = w[i]
     _apply_reflectors(A, beta, r, z, nu)            # z = Q1 w = Y lam
-    for i in range(nu - 1, -1, -1):                 # u' += L^-T z
+    add_back_solved(L, z, ud)
+    _min_norm_multipliers(A, Rd, r, mc, w, B, Ud, beta2, mu)
+    for i in range(mc):
+        lam[int(index[int(perm[i])])] = mu[i]
+
+
+@njit(cache=True, inline="always")
+def add_back_solved(L, z, ud):
+    """``ud += L^-T z`` (``z`` overwritten by ``L^-T z``): a correction ``z = Y lam`` of
+    the accelerations, ``M^-1 G^T lam`` with ``M = L L^T``."""
+    nu = L.shape[0]
+    for i in range(nu - 1, -1, -1):
         s = z[i]
         for k in range(i + 1, nu):
             s -= L[k, i] * z[k]
         z[i] = s / L[i, i]
     for i in range(nu):
         ud[i] += z[i]
-    _min_norm_multipliers(A, Rd, r, mc, w, B, Ud, beta2, mu)
-    for i in range(mc):
-        lam[int(index[int(perm[i])])] = mu[i]
+
+
+@njit(cache=True, inline="always")
+def pivoted_back(A, perm, rank, rhs, out, x):
+    """``out`` (all rows): the solution of the pivoted rows' system ``C C^T x =
+    rhs[perm[:rank]]`` at those rows, zero elsewhere (``C`` in ``A``'s lower triangle;
+    ``perm``: row numbers, as floats; ``x``: at least ``rank`` floats of scratch, left
+    holding the solution in pivot order)."""
+    for i in range(rank):
+        s = rhs[int(perm[i])]
+        for k in range(i):
+            s -= A[i, k] * x[k]
+        x[i] = s / A[i, i]
+    for i in range(rank - 1, -1, -1):
+        s = x[i]
+        for k in range(i + 1, rank):
+            s -= A[k, i] * x[k]
+        x[i] = s / A[i, i]
+    for j in range(out.shape[0]):
+        out[j] = 0.0
+    for i in range(rank):
+        out[int(perm[i])] = x[i]
 
 
 @njit(cache=True, inline="always")
@@ -221,14 +251,15 @@ def _pivoted_cholesky(B, mc, perm):
 
 
 @njit(cache=True, inline="always")
-def _gram_solve(A, mc, res, index, L, ud, lam, info, B, perm, w, z):
+def _gram_solve(A, mc, res, index, L, ud, lam, info, B, perm, rows, w, z):
     """The constrained ``u'`` and the multipliers when the ``mc`` columns of ``A = Y`` (the
     rows ``index[:mc]`` of ``G``) are independent and well conditioned: ``B = A^T A``
     factored by Cholesky with diagonal pivoting, ``B[perm][:, perm] = C C^T`` (``C`` in
     ``B``'s lower triangle); then ``B lam = res`` and ``u' += L^-T A lam``.  Returns False,
     with ``ud``, ``lam`` and ``info`` untouched, when a pivot falls below
     ``WELL_CONDITIONED^2`` of the first (dependent or nearly dependent rows: the pivoted QR
-    decides) or there are more rows than speeds.  ``w``, ``z``: scratch of ``nu``."""
+    decides) or there are more rows than speeds.  ``rows``: scratch of ``mc``; ``w``,
+    ``z``: scratch of ``nu``."""
     nu = A.shape[0]
     if mc > nu:
         return False
@@ -243,31 +274,17 @@ def _gram_solve(A, mc, res, index, L, ud, lam, info, B, perm, w, z):
     first = _pivoted_cholesky(B, mc, perm)
     if first == 0.0:
         return False
-    for i in range(mc):                             # C C^T x = (P^T res): x into w
-        s = res[int(index[int(perm[i])])]
-        for k in range(i):
-            s -= B[i, k] * w[k]
-        w[i] = s / B[i, i]
-    for i in range(mc - 1, -1, -1):
-        s = w[i]
-        for k in range(i + 1, mc):
-            s -= B[k, i] * w[k]
-        w[i] = s / B[i, i]
+    for i in range(mc):                             # the pivots' row numbers in G
+        rows[i] = index[int(perm[i])]
+    pivoted_back(B, rows, mc, res, lam, w)          # C C^T x = P^T res, lam = P x
     for i in range(nu):
         z[i] = 0.0
-    for j in range(mc):                             # z = A lam, lam = P x
+    for j in range(mc):                             # z = A lam
         x = w[j]
         col = int(perm[j])
-        lam[int(index[col])] = x
         for i in range(nu):
             z[i] += A[i, col] * x
-    for i in range(nu - 1, -1, -1):                 # u' += L^-T z
-        s = z[i]
-        for k in range(i + 1, nu):
-            s -= L[k, i] * z[k]
-        z[i] = s / L[i, i]
-    for i in range(nu):
-        ud[i] += z[i]
+    add_back_solved(L, z, ud)
     info[0] = mc
     info[1] = B[mc - 1, mc - 1] / np.sqrt(first)
     return True
