@@ -44,6 +44,9 @@ from ..errors import ModelError
 from .symbols import cross
 
 AXES = "xyz"
+#: the flag ``Walk.joint_values`` holds for a node frame's chain joint (its coordinate a
+#: row of the modes at the node times ``eta``: moved, like a drive, but by the modes)
+CHAIN = "chain"
 #: an invariant's entry below this fraction of the largest of its matrix is an exact 0
 ZERO = 1e-11
 
@@ -58,7 +61,7 @@ class _Names:
 
     def __init__(self, body, taken):
         self.body, self.taken = body, taken
-        self.constants, self.matrices = {}, {}
+        self.constants, self.matrices, self.meanings = {}, {}, {}
 
     def symbol(self, name, value):
         full = f"{self.body}_{name}"
@@ -71,9 +74,9 @@ class _Names:
         self.constants[s] = float(value)
         return s
 
-    def matrix(self, label, values, rows, cols, symmetric=False, skew=False):
+    def matrix(self, label, values, rows, cols, symmetric=False, skew=False, meaning=""):
         """A matrix of symbols ``label_row_col`` (zeros exact); ``symmetric``/``skew``:
-        one symbol per pair."""
+        one symbol per pair; ``meaning`` for the reports."""
         values = np.atleast_2d(np.asarray(values, float))
         big = np.abs(values).max(initial=0.0)
         out = sympy.zeros(*values.shape)
@@ -85,8 +88,11 @@ class _Names:
             if abs(v) <= ZERO * big or (skew and i == j):
                 continue
             sep = "" if rows[i].isalpha() and cols[j].isalpha() else "_"
-            out[i, j] = self.symbol(f"{label}_{rows[i]}{sep}{cols[j]}", v)
+            index = rows[i] + sep + cols[j] if rows[i] else cols[j]
+            out[i, j] = self.symbol(f"{label}_{index}", v)
         self.matrices[label] = out
+        if meaning:
+            self.meanings[label] = meaning
         return out
 
     def vector(self, label, values, rows):
@@ -120,7 +126,8 @@ class FlexibleBodyTerms:
         self.eta = sympy.Matrix(sym.q[k0:k0 + fb.n])
         self.eta_dot = sympy.Matrix(sym.u[u0:u0 + fb.n])
         modes = [str(k + 1) for k in range(fb.n)]
-        inv, nm = fb.invariants, _Names(fb.name, taken)
+        inv = fb.invariants
+        nm = walk.chain_names.get(fb.name) or _Names(fb.name, taken)
         self.names = nm
         self.m = nm.symbol("m", inv.mass)
         nm.matrices["m"] = sympy.Matrix([[self.m]])
@@ -269,15 +276,41 @@ def _is_sym(A):
     return bool(np.allclose(A, A.T, rtol=0, atol=ZERO * max(np.abs(A).max(), 1e-300)))
 
 
+def chain_values(walk):
+    """``{joint: (q, u, u', CHAIN)}`` of the node frames' chain joints
+    (``elements.flexible_nodes``): each coordinate ``D_j eta``, its rate ``D_j eta'`` and
+    acceleration ``D_j eta''``, the entries of ``D`` (the mode shapes at the node, as the
+    numeric ``StateMap`` has them) named ``BODY_NODE_c_k`` (the chain coordinate's name,
+    then the mode) with their values in ``walk.constants``."""
+    model, sym = walk.model, walk.sym
+    walk.constants, walk.taken, walk.chain_names = {}, set(sym.table), {}
+    out = {}
+    for nf in getattr(model, "node_frames", ()):
+        rec = model.flexible[nf.body]
+        k0, u0 = model.coordinates.index(rec.coordinates[0]), model.speeds.index(rec.speeds[0])
+        eta, rate = sym.q[k0:k0 + rec.n_modes], sym.u[u0:u0 + rec.n_modes]
+        accel = sym.ud[u0:u0 + rec.n_modes]
+        names = walk.chain_names.setdefault(nf.body, _Names(nf.body, walk.taken))
+        for joint, row in zip(nf.joints, nf.rows):
+            coordinate = model.tree.joint(joint).coordinates[0]
+            D = names.matrix(coordinate[len(nf.body) + 1:], np.reshape(row, (1, -1)), [""],
+                             [str(k + 1) for k in range(row.size)],
+                             meaning=f"node frame {nf.name}: {coordinate} per mode")
+            q, u, ud = ((D * sympy.Matrix(v))[0] for v in (eta, rate, accel))
+            out[joint] = ([q], [u], [ud], CHAIN)
+        walk.constants.update(names.constants)
+    return out
+
+
 def attach(walk):
     """The walk's ``flexible`` terms (``FlexibleBodyTerms`` per body), the modal
     coordinates' kinematic equations ``eta' = u`` and the invariants' values
     ``walk.constants``; what the symbolic layer cannot write is refused, named."""
     model = walk.model
-    walk.flexible, walk.constants, walk.flexible_by_frame = [], {}, {}
+    walk.flexible, walk.flexible_by_frame = [], {}
     if not getattr(model, "flexible_bodies", ()):
         return
-    taken = set(walk.sym.table)
+    taken = walk.taken
     for fb in model._flex:
         body = FlexibleBodyTerms(walk, fb, taken)
         for e, ed in zip(body.eta, body.eta_dot):
@@ -297,11 +330,6 @@ def check(model):
                              f"{limits.MAX_SYMBOLIC_MODES} modes in closed form "
                              f"(limits.MAX_SYMBOLIC_MODES); {fb.name!r} has {fb.n}: give it "
                              f"modes = {limits.MAX_SYMBOLIC_MODES} or fewer")
-    if model.node_frames:
-        nf = model.node_frames[0]
-        raise ModelError(f"{where} writes joints at a flexible body's frame origin only; "
-                         f"{nf.name!r} hangs joints at a node of {nf.body!r}: attach them at "
-                         "its frame origin, or use the numeric routes")
     if model._flex_elements:
         pk = model._flex_elements[0]
         raise ModelError(f"{where} does not write loads and force elements at flexible "

@@ -52,6 +52,8 @@ def latex_names(d):
         top = r"\mathrm{" + body.name.replace("_", r"\_") + "}"
         for s in body.names.constants:
             kind, *rest = s.name[len(body.name) + 1:].split("_")
+            if kind not in LATEX:             # a mode shape at a node: its own name
+                continue
             letter, first = LATEX[kind]
             sub = ",".join(p for p in [first, *rest] if p)
             out[s] = f"{letter}^{{{top}}}" + (f"_{{{sub}}}" if sub else "")
@@ -64,7 +66,8 @@ def _values(body):
     for label, M in body.names.matrices.items():
         named = [(e.name, body.names.constants[e]) for e in dict.fromkeys(
             e for e in M if e.is_Symbol)]
-        out.append((label, MEANING.get(_kind(label), ""), named))
+        out.append((label, body.names.meanings.get(label) or MEANING.get(_kind(label), ""),
+                    named))
     if body.Omega is not None:
         out.append(("Omega", MEANING["Omega"], [(body.Omega.name,
                                                  body.names.constants[body.Omega])]))

@@ -27,6 +27,7 @@ import sympy
 
 from ..compiled.layout import reaction_basis
 from ..errors import ModelError
+from .flexible import CHAIN
 from .simplify import diff
 from .symbols import cross, exact_vector
 
@@ -130,7 +131,7 @@ def newton_euler(walk):
     nu = len(sym.u)
     wrench = {}
     bodies = []
-    rows = {}
+    rows, pushes = {}, []
     ud = sympy.Matrix(sym.ud) if nu else sympy.zeros(0, 1)
     for m in reversed(walk.motions):
         I = m.inertia_basis
@@ -161,18 +162,27 @@ def newton_euler(walk):
         bodies.append({"body": m.name, "joint": m.joint.name, "basis": m.basis,
                        "m_aG": maG, "euler_G": euler_G, "force": m.force,
                        "moment": m.moment, "com": c, "children": child_terms})
-        # equations of motion: no reaction along the joint's free directions
+        # equations of motion: no reaction along the joint's free directions; a node
+        # frame's chain joint's effort along its coordinate pushes the modes (D^T tau)
         qj, uj, udj, driven = walk.joint_values[m.joint.name]
-        if driven or not uj:
+        chain = driven == CHAIN
+        if (driven and not chain) or not uj:
             continue
-        for u in uj:
+        for u in walk.speeds_of(m.joint, uj):
             dF = m.v_rel_basis.applyfunc(lambda e: diff(e, u))
             dM = m.w_rel_basis.applyfunc(lambda e: diff(e, u))
-            rows[sym.u.index(u)] = (dF.T * AF + dM.T * AM, (dF.T * bF)[0] + (dM.T * bM)[0])
+            row = (dF.T * AF + dM.T * AM, (dF.T * bF)[0] + (dM.T * bM)[0])
+            r = sym.u.index(u)
+            if chain:
+                pushes.append((r, row))
+            else:
+                rows[r] = row
     bodies.reverse()
     for body in walk.flexible:              # and its modal rows
         for r, a, b in body.modal_rows():
             rows[r] = (a, b)
+    for r, (a, b) in pushes:
+        rows[r] = (rows[r][0] + a, rows[r][1] + b)
     M = sympy.zeros(nu, nu)
     f = sympy.zeros(nu, 1)
     for r, (a, b) in rows.items():

@@ -32,6 +32,7 @@ import numpy as np
 import sympy
 
 from ..errors import ModelError
+from .flexible import CHAIN, chain_values
 from .flexible import attach as attach_flexible
 from .flexible import check as check_flexible
 from .force_elements import apply_forces, reflected_inertia
@@ -78,7 +79,8 @@ class Walk:
         self.frames = frames
         self.simplify = simplify
         self.sym = sym = Symbols(model)
-        bodies, joints, loads = model.elements
+        flexible = getattr(model, "flexible_bodies", ())
+        bodies, joints, loads = model.tree.elements if flexible else model.elements
         self.bodies, self.joints, self.loads = bodies, joints, loads
         self.gravity = self._gravity()
         self.qdot = {}
@@ -89,8 +91,9 @@ class Walk:
         self.joint_values = {}
         self.units = []                     # unit quaternions: their squares sum to 1
         qi = ui = walked = 0
+        chains = chain_values(self)         # node frames' chains: moved by the modes
         for i, (body, joint) in enumerate(zip(bodies, joints)):
-            qj, uj, udj, driven = _joint_values(joint, sym, qi, ui)
+            qj, uj, udj, driven = chains.get(joint.name) or _joint_values(joint, sym, qi, ui)
             self.joint_values[joint.name] = (qj, uj, udj, driven)
             if not driven and joint.nu:
                 if joint.kind == "spherical":
@@ -257,7 +260,7 @@ class Walk:
         JO_p = parent.JO if parent is not None else sympy.zeros(3, len(self.sym.u))
         JR = X * JR_p
         JO = X * JO_p - _cross_columns(rho, JR)
-        for u in (uj if not self._driven(joint) else ()):
+        for u in self.speeds_of(joint, uj):
             col = self.sym.u.index(u)
             JR[:, col] += w_rel_b.diff(u)
             JO[:, col] += v_rel.diff(u)
@@ -267,6 +270,14 @@ class Walk:
 
     def _driven(self, joint):
         return self.joint_values[joint.name][3]
+
+    def speeds_of(self, joint, uj):
+        """The free speeds a joint's relative motion is linear in: its own, none for a
+        drive, the modal rates for a node frame's chain joint (``symbolic.flexible``)."""
+        driven = self._driven(joint)
+        if driven == CHAIN:
+            return sorted(free_symbols(uj[0]) & set(self.sym.u), key=self.sym.u.index)
+        return () if driven else uj
 
     def absolute_T(self, name):
         """The transformation matrix ``B s = T I s`` of a frame from the inertial frame."""
