@@ -2,7 +2,7 @@
 its first critical speed from mbdyn's reduced shaft against the closed form of a
 cantilever with a tip mass, and the run-up through it -- the quasi-static unbalance
 response below it, the peak just past it, the disk self-centring above it.  The default
-(numpy) route, about 10 s; the compiled route and Exudyn are in
+(numpy) route, about 17 s; the compiled route and Exudyn are in
 benchmarks/flexible_rotor_exudyn.py."""
 import math
 import tomllib
