@@ -30,9 +30,10 @@ How the two models are made the same:
   node ``tip``, its centre of mass at ``(0, EPS, 0)`` in the node's frame.  Exudyn: one
   more mass point at ``(L, EPS, 0)`` whose mode shapes are the tip node's carried to it,
   ``Phi_tip - s~ Psi_tip`` with ``s = (0, EPS, 0)``.  The same to first order in the tip's
-  rotation; mbdyn turns the node frame by the rotation exactly (``Rx Ry Rz``), so the
-  unbalance's radius differs by ``EPS theta^2 / 2`` (theta the tip slope, up to 1e-3 rad
-  here): a relative 1e-6 of the unbalance force.
+  rotation; mbdyn turns the node frame by the rotation exactly (``Rx Ry Rz``), which
+  gives terms of order ``M_U EPS^2 Omega^2 theta`` the linear point lacks: the tools'
+  references differ by 2.7e-9 m (1.2e-5 of the peak), in proportion to EPS at the same
+  unbalance ``M_U EPS`` (2.0e-10 m at EPS = 1 mm, 2.8e-8 m at 100 mm).
 * **Spin.**  mbdyn: the joint's drive ``0.5*ALPHA*t**2``.  Exudyn: a ``GenericJoint``
   from the ground to the frame's node (rotation parameters Rxyz) holding all but the
   rotation about x, and a ``CoordinateConstraint`` on that rotation coordinate whose
