@@ -49,8 +49,13 @@ How the two models are made the same:
 The solvers, the error measure (largest distance to mbdyn's DOP853 at rtol 1e-12, Exudyn's
 also to its own finest run), CPU time (process time of the solve, median of interleaved
 repeats, one thread) and the equal-accuracy table are those of
-benchmarks/flexible_exudyn.py.  mbdyn's compiled terms are warmed up first (the first use
-of the "force elements" kind compiles for about 35 s on an empty numba cache; not counted).
+benchmarks/flexible_exudyn.py.  mbdyn's settings, all with ``compiled_terms = True``: the
+compiled explicit loops (DOP853, RK45; rtol, atol = 1e-3 rtol), the compiled fixed-step
+implicit midpoint rule (dt; a forward-difference Jacobian every step), and scipy's
+implicit Radau, BDF, LSODA (rtol; the compiled state derivative called from Python, the
+Jacobian by scipy's finite differences).  mbdyn's compiled code is warmed up first (the
+first use of the "force elements" kind compiles for about 35 s on an empty numba cache,
+the implicit midpoint's loop about 30 s more; not counted).
 """
 import os
 
@@ -125,14 +130,31 @@ class Rotor:
         return self.par["ALPHA"] * np.asarray(t)
 
 
-def mbdyn_run(r, integrator, rtol, compiled, t_eval=None):
+FIXED = ("implicit-midpoint",)          # mbdyn's fixed-step integrators used here: x is dt
+
+
+def mbdyn_run(r, integrator, x, compiled, t_eval=None):
+    """One mbdyn solve; ``x`` is rtol (atol = 1e-3 rtol), or the step for a fixed-step
+    integrator.  Returns (result, CPU of the solve)."""
     m = r.model
     m.compiled_terms = compiled
+    step = dict(dt=x) if integrator in FIXED else dict(rtol=x, atol=x * 1e-3)
     t0 = process_time()
-    res = mb.simulate(m, r.t_end, r.scene.q0, r.scene.u0, integrator=integrator, rtol=rtol,
-                      atol=rtol * 1e-3, t_eval=r.t_out if t_eval is None else t_eval)
+    res = mb.simulate(m, r.t_end, r.scene.q0, r.scene.u0, integrator=integrator,
+                      t_eval=r.t_out if t_eval is None else t_eval, **step)
     cpu = process_time() - t0
     return res, cpu
+
+
+def mbdyn_label(integrator, x):
+    """The (solver, setting, work) of a run's row."""
+    if integrator in FIXED:         # the compiled fixed-step loop
+        return f"{integrator} compiled", f"dt {x:g}", "{steps} steps, {evals} evals"
+    if integrator in ("RK45", "DOP853"):     # the compiled adaptive loops
+        return f"{integrator} compiled", f"rtol {x:g}", "{evals} evals"
+    # scipy's solver stepping the compiled state derivative from Python; its Jacobian by
+    # scipy's finite differences
+    return f"{integrator} (scipy)", f"rtol {x:g}", "{steps} steps, {evals} evals, {njev} jac"
 
 
 def mbdyn_deflection(r, res):
@@ -261,6 +283,14 @@ def main():
                        1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10))]
     mb_settings += [("RK45", x, True) for x in ((1e-4, 1e-6, 1e-8) if args.quick
                                                 else (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8))]
+    # the implicit integrators: the compiled fixed-step implicit midpoint rule (dt), scipy's
+    # Radau, BDF, LSODA (compiled terms, from Python)
+    mb_settings += [("implicit-midpoint", x, True) for x in (
+        (8e-3, 4e-3, 2e-3, 1e-3) if args.quick else (8e-3, 5e-3, 4e-3, 2e-3, 1e-3, 5e-4))]
+    mb_settings += [(integ, x, True) for integ, xs in (
+        ("Radau", (1e-2, 1e-3, 1e-4) if args.quick else (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)),
+        ("BDF", (1e-2, 1e-3) if args.quick else (1e-2, 1e-3, 1e-4, 1e-5)),
+        ("LSODA", (1e-2, 1e-3) if args.quick else (1e-2, 1e-3, 1e-4, 1e-5))) for x in xs]
     ex_settings = []
     if exu is not None:
         steps = (312, 625, 1250, 2500, 5000, 10000, 40000) if args.quick else (
@@ -287,9 +317,13 @@ def main():
     for _ in range(repeats):
         for integ, x, c in mb_settings:
             res, cpu = mbdyn_run(r, integ, x, c)
-            key = ("mbdyn", f"{integ} compiled", f"rtol {x:g}")
+            solver, setting, work = mbdyn_label(integ, x)
+            st = res.stats
+            key = ("mbdyn", solver, setting)
             runs.setdefault(key, {"cpu": [], "err": error(*mbdyn_deflection(r, res), ref),
-                                  "work": f"{res.stats['rhs_evaluations']} evals"})
+                                  "work": work.format(evals=st["rhs_evaluations"],
+                                                      steps=st.get("steps", "?"),
+                                                      njev=st.get("njev", "?"))})
             runs[key]["cpu"].append(cpu)
         for solver, n in ex_settings:
             t, y, cpu = exudyn_run(r, solver, n)
