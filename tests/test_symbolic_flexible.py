@@ -294,10 +294,14 @@ def test_what_the_symbolic_layer_does_not_write_is_refused_by_name(make, match):
         derive(m, "jourdain")
 
 
-def test_the_rotor_file_is_refused_by_its_modes():
-    m = mb.load_model(MODELS / "jeffcott_flexible.toml").model
-    with pytest.raises(ModelError, match="at most 4 modes"):
-        derive(m)
+def test_the_rotor_files_are_refused_by_name():
+    """The shipped files the layer does not write say why: the rotor's 16 modes, the
+    run-up's damper at the tip node (a force element at a flexible body)."""
+    for name, match in (("jeffcott_flexible", "at most 4 modes"),
+                        ("flexible_rotor_runup", "loads and force elements at flexible")):
+        m = mb.load_model(MODELS / f"{name}.toml").model
+        with pytest.raises(ModelError, match=match):
+            derive(m)
 
 
 def test_a_joint_at_a_node_solved_in_closed_form():
