@@ -162,21 +162,7 @@ def newton_euler(walk):
         bodies.append({"body": m.name, "joint": m.joint.name, "basis": m.basis,
                        "m_aG": maG, "euler_G": euler_G, "force": m.force,
                        "moment": m.moment, "com": c, "children": child_terms})
-        # equations of motion: no reaction along the joint's free directions; a node
-        # frame's chain joint's effort along its coordinate pushes the modes (D^T tau)
-        qj, uj, udj, driven = walk.joint_values[m.joint.name]
-        chain = driven == CHAIN
-        if (driven and not chain) or not uj:
-            continue
-        for u in walk.speeds_of(m.joint, uj):
-            dF = m.v_rel_basis.applyfunc(lambda e: diff(e, u))
-            dM = m.w_rel_basis.applyfunc(lambda e: diff(e, u))
-            row = (dF.T * AF + dM.T * AM, (dF.T * bF)[0] + (dM.T * bM)[0])
-            r = sym.u.index(u)
-            if chain:
-                pushes.append((r, row))
-            else:
-                rows[r] = row
+        _free_direction_rows(walk, m, (AF, bF, AM, bM), rows, pushes)
     bodies.reverse()
     for body in walk.flexible:              # and its modal rows
         for r, a, b in body.modal_rows():
@@ -191,6 +177,27 @@ def newton_euler(walk):
         f[r] = s(-b)
     return Equations("newton-euler", M, f, {"bodies": bodies,
                                             "reactions": _Reactions(walk, wrench, ud)})
+
+
+def _free_direction_rows(walk, m, wrench, rows, pushes):
+    """The equations of motion at frame ``m``'s joint: no reaction along its free
+    directions (``rows[r] = (a, b)``, the row ``a u' + b = 0`` of speed ``r``); a node
+    frame's chain joint's effort along its coordinate pushes the modes instead
+    (``pushes``: added to the modal rows, ``D^T tau``)."""
+    AF, bF, AM, bM = wrench
+    qj, uj, udj, driven = walk.joint_values[m.joint.name]
+    chain = driven == CHAIN
+    if (driven and not chain) or not uj:
+        return
+    for u in walk.speeds_of(m.joint, uj):
+        dF = m.v_rel_basis.applyfunc(lambda e: diff(e, u))
+        dM = m.w_rel_basis.applyfunc(lambda e: diff(e, u))
+        row = (dF.T * AF + dM.T * AM, (dF.T * bF)[0] + (dM.T * bM)[0])
+        r = walk.sym.u.index(u)
+        if chain:
+            pushes.append((r, row))
+        else:
+            rows[r] = row
 
 
 class _Reactions:
