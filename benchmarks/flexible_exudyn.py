@@ -202,6 +202,28 @@ def rayleigh(red):
     return np.linalg.solve(A, 2 * zeta * w)
 
 
+def ground_joint(mbs, node, constrained_axes):
+    """The ground, and a ``GenericJoint`` from it (at the origin) to the rigid ``node``
+    holding ``constrained_axes``; returns the ground object's number."""
+    o_ground = mbs.AddObject(eii.ObjectGround())
+    m_ground = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=o_ground, localPosition=[0, 0, 0]))
+    m_node = mbs.AddMarker(eii.MarkerNodeRigid(nodeNumber=node))
+    mbs.AddObject(eii.GenericJoint(markerNumbers=[m_ground, m_node],
+                                   constrainedAxes=list(constrained_axes)))
+    return o_ground
+
+
+def timed_solve(mbs, settings, solver):
+    """``SolveDynamic`` with Exudyn's ``solver``; returns its CPU seconds (raises if it
+    failed)."""
+    t0 = process_time()
+    ok = mbs.SolveDynamic(settings, solverType=getattr(exu.DynamicSolverType, solver))
+    cpu = process_time() - t0
+    if not ok:
+        raise RuntimeError(f"Exudyn {solver} failed")
+    return cpu
+
+
 def exudyn_build(p, mass_load=False):
     """An Exudyn system of the pendulum; returns (SC, mbs, sensor numbers, reduced data)."""
     SC = exu.SystemContainer()
@@ -226,11 +248,7 @@ def exudyn_build(p, mass_load=False):
             bodyNumber=obj["oFFRFreducedOrder"], meshNodeNumbers=list(range(len(m))),
             weightingFactors=list(m / m.sum())))
         mbs.AddLoad(eii.LoadForceVector(markerNumber=marker, loadVector=list(m.sum() * G)))
-    o_ground = mbs.AddObject(eii.ObjectGround())
-    m_ground = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=o_ground, localPosition=[0, 0, 0]))
-    m_frame = mbs.AddMarker(eii.MarkerNodeRigid(nodeNumber=n_rigid))
-    mbs.AddObject(eii.GenericJoint(markerNumbers=[m_ground, m_frame],
-                                   constrainedAxes=[1, 1, 1, 1, 1, 0]))
+    ground_joint(mbs, n_rigid, [1, 1, 1, 1, 1, 0])
     s_rigid = mbs.AddSensor(eii.SensorNode(nodeNumber=n_rigid, storeInternal=True,
                                            outputVariableType=exu.OutputVariableType.Coordinates))
     s_modal = mbs.AddSensor(eii.SensorNode(nodeNumber=n_modal, storeInternal=True,
@@ -259,15 +277,9 @@ def exudyn_settings(p, solver, steps, write=0.002):
 def exudyn_run(p, solver, steps, mass_load=False):
     """One Exudyn solve of a freshly built system; returns (t, tip, cpu, steps)."""
     SC, mbs, sensors, _ = exudyn_build(p, mass_load)
-    settings = exudyn_settings(p, solver, steps)
-    stype = getattr(exu.DynamicSolverType, solver)
-    t0 = process_time()
-    ok = mbs.SolveDynamic(settings, solverType=stype)
-    cpu = process_time() - t0
+    cpu = timed_solve(mbs, exudyn_settings(p, solver, steps), solver)
     rigid = mbs.GetSensorStoredData(sensors[0])
     modal = mbs.GetSensorStoredData(sensors[1])
-    if not ok:
-        raise RuntimeError(f"Exudyn {solver} failed")
     return rigid[:, 0], p.tip(rigid[:, 6], modal[:, 1:]), cpu, int(steps)
 
 
@@ -338,11 +350,7 @@ def crank_exudyn_build(c):
                                       physicsInertia=[1e-9, Jyy + P["M1"] * L1 ** 2 / 4,
                                                       Jyy + P["M1"] * L1 ** 2 / 4, 0, 0, 0],
                                       physicsCenterOfMass=[L1 / 2, 0, 0]))
-    o_ground = mbs.AddObject(eii.ObjectGround())
-    m_ground = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=o_ground, localPosition=[0, 0, 0]))
-    m_crank0 = mbs.AddMarker(eii.MarkerNodeRigid(nodeNumber=n_crank))
-    mbs.AddObject(eii.GenericJoint(markerNumbers=[m_ground, m_crank0],
-                                   constrainedAxes=[1, 1, 1, 1, 1, 0]))
+    ground_joint(mbs, n_crank, [1, 1, 1, 1, 1, 0])
     n_g = mbs.AddNode(eii.NodePointGround())
     m_gc = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=n_g, coordinate=0))
     m_rz = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=n_crank, coordinate=5))
@@ -389,12 +397,7 @@ def crank_exudyn_build(c):
 def crank_exudyn_run(c, solver, steps):
     mbs, (s_modal, s_sl), _ = crank_exudyn_build(c)
     p = type("P", (), {"t_end": c.t_end})
-    settings = exudyn_settings(p, solver, steps, write=0.0005)
-    t0 = process_time()
-    ok = mbs.SolveDynamic(settings, solverType=getattr(exu.DynamicSolverType, solver))
-    cpu = process_time() - t0
-    if not ok:
-        raise RuntimeError(f"Exudyn {solver} failed")
+    cpu = timed_solve(mbs, exudyn_settings(p, solver, steps, write=0.0005), solver)
     modal = mbs.GetSensorStoredData(s_modal)
     sl = mbs.GetSensorStoredData(s_sl)
     return modal[:, 0], c.series(sl[:, 1], modal[:, 1:]), cpu

@@ -73,7 +73,8 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from flexible_exudyn import (EXUDYN, ROOT, _PointMesh, _Points, all_runs,  # noqa: E402
-                             equal_accuracy, error, exu, exudyn_settings, reference_spline)
+                             equal_accuracy, error, exu, exudyn_settings, ground_joint,
+                             reference_spline, timed_solve)
 
 import mbdyn as mb  # noqa: E402
 from mbdyn.flexible import beam_from_spec  # noqa: E402
@@ -173,11 +174,7 @@ def exudyn_build(r):
     cms.inertiaLocal = cms.inertiaLocal + np.sum(r.points.inertia, axis=0)   # the twist
     obj = cms.AddObjectFFRFreducedOrder(mbs, positionRef=[0, 0, 0])
     n_rigid, n_modal = obj["nRigidBody"], obj["nGenericODE2"]
-    o_ground = mbs.AddObject(eii.ObjectGround())
-    m_ground = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=o_ground, localPosition=[0, 0, 0]))
-    m_frame = mbs.AddMarker(eii.MarkerNodeRigid(nodeNumber=n_rigid))
-    mbs.AddObject(eii.GenericJoint(markerNumbers=[m_ground, m_frame],
-                                   constrainedAxes=[1, 1, 1, 0, 1, 1]))
+    o_ground = ground_joint(mbs, n_rigid, [1, 1, 1, 0, 1, 1])
     # the spin: the frame's rotation about x (Rxyz's first angle) prescribed
     n_g = mbs.AddNode(eii.NodePointGround())
     m_gc = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=n_g, coordinate=0))
@@ -213,12 +210,7 @@ def exudyn_build(r):
 def exudyn_run(r, solver, steps):
     """One Exudyn solve of a freshly built system; returns (t, deflection, cpu)."""
     mbs, s_modal, _, keep = exudyn_build(r)
-    settings = exudyn_settings(r, solver, steps, write=SAMPLE)
-    t0 = process_time()
-    ok = mbs.SolveDynamic(settings, solverType=getattr(exu.DynamicSolverType, solver))
-    cpu = process_time() - t0
-    if not ok:
-        raise RuntimeError(f"Exudyn {solver} failed")
+    cpu = timed_solve(mbs, exudyn_settings(r, solver, steps, write=SAMPLE), solver)
     modal = mbs.GetSensorStoredData(s_modal)
     return modal[:, 0], r.deflection(modal[:, 1:]), cpu
 
