@@ -51,7 +51,7 @@ also to its own finest run), CPU time (process time of the solve, median of inte
 repeats, one thread) and the equal-accuracy table are those of
 benchmarks/flexible_exudyn.py.  mbdyn's settings, all with ``compiled_terms = True``: the
 compiled explicit loops (DOP853, RK45; rtol, atol = 1e-3 rtol), the compiled fixed-step
-implicit midpoint rule (dt; a forward-difference Jacobian every step), and scipy's
+implicit midpoint rule (dt; its iteration matrix kept over steps), and scipy's
 implicit Radau, BDF, LSODA (rtol; the compiled state derivative called from Python, the
 Jacobian by scipy's finite differences).  mbdyn's compiled code is warmed up first (the
 first use of the "force elements" kind compiles for about 35 s on an empty numba cache,

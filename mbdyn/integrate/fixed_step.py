@@ -147,9 +147,10 @@ def python_chunks(plan):
     project = model.has_loops
     t, y = plan.t0, plan.y0.copy()
     for h, ts in step_times(plan.t0, plan.t_end, plan.dt):
+        memory = {}                 # what the implicit midpoint rule keeps over the steps
         for t_new in ts:
             try:
-                y_new, rate = fixed_step(plan.rhs, plan.integrator, t, y, h, nq)
+                y_new, rate = fixed_step(plan.rhs, plan.integrator, t, y, h, nq, memory)
                 if project:
                     y_new[:nq], y_new[nq:] = model.project(y_new[:nq], y_new[nq:], t_new)
             except (NonFiniteError, SingularMassMatrixError, SimulationError) as exc:

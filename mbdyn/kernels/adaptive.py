@@ -29,7 +29,8 @@ import numpy as np
 from numba import njit
 
 from .events import step_ends_stretch
-from .integrators import _rhs, finish_step
+from .routes import finish_step
+from .state_rate import state_rate
 from .programs import STACK, drive_values
 from .views import UNCOUNTED, untracked
 
@@ -189,8 +190,8 @@ def stage(t, y, ops, consts, starts, stack, dv, nq, slots, free_q, free_u, drive
     (13 s of its first run instead of 8), and the call costs nothing measurable."""
     if dv.shape[0]:
         drive_values(ops, consts, starts, t, stack, dv)
-    return _rhs(y, dv, nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads, ws,
-                ydot, nfev)
+    return state_rate(y, dv, nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads, ws,
+                      ydot, nfev)
 
 
 @njit(cache=True, inline="always")
