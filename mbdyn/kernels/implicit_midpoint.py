@@ -29,7 +29,7 @@ FRESH_ITERATIONS = 30
 NEWTON_TOL = 1e-14
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def lu_factor(A, piv):
     """Factor ``A`` in place as ``P A = L U`` (partial pivoting; ``piv[k]``: the row
     swapped with row ``k`` at step ``k``).  Returns -1, or the column whose pivot is
@@ -58,7 +58,7 @@ def lu_factor(A, piv):
     return -1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def lu_apply(LU, piv, x):
     """``x = A^-1 x`` in place with ``lu_factor``'s ``LU`` and ``piv`` of ``A``."""
     n = x.shape[0]
@@ -79,6 +79,16 @@ def lu_apply(LU, piv, x):
 
 
 @njit(cache=True)
+def _rate(y, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads, ws,
+          ydot, nfev):
+    """``state_rate`` compiled once, as a function of its own, for every evaluation of
+    the step: inlined at each of its four call sites it was compiled four times (the
+    loop's first compile about 3 s longer, of 28 s on a busy machine)."""
+    return state_rate(y, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body,
+                      loads, ws, ydot, nfev)
+
+
+@njit(cache=True, inline="always")
 def newton_scratch(ny):
     """What ``implicit_midpoint_step`` keeps over steps besides the matrix ``J`` it
     factors: the inverse ``H``, the pivots ``piv`` (``piv[ny]`` is 1 while ``H`` holds an
@@ -96,8 +106,8 @@ def implicit_midpoint_step(y, y1, y2, back, h, drive_start, drive_vals, nq, slot
     (``newton_scratch``): as the previous step left them.  Returns a status: 0, a
     failed evaluation's, or 3 (no convergence with a fresh matrix, or a singular one)."""
     ny = y.shape[0]
-    st = state_rate(y, drive_start, nq, slots, free_q, free_u, drive_q, drive_u, tree, body,
-                    loads, ws, f0, nfev)
+    st = _rate(y, drive_start, nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads, ws,
+               f0, nfev)
     if st:
         return st
     if back >= 2 and piv[ny] == 1:                 # the quadratic through the last states
@@ -115,8 +125,8 @@ def implicit_midpoint_step(y, y1, y2, back, h, drive_start, drive_vals, nq, slot
     while left > 0:
         for i in range(ny):
             ym[i] = 0.5 * (y[i] + yn[i])
-        st = state_rate(ym, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree,
-                        body, loads, ws, fm, nfev)
+        st = _rate(ym, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads,
+                   ws, fm, nfev)
         if st and not fresh:                      # a kept matrix led astray: start again
             renew, fresh = True, True
             copy_into(pred, yn)
@@ -153,14 +163,14 @@ def _explicit_midpoint(y, h, f0, drive_vals, nq, slots, free_q, free_u, drive_q,
     """``pred = y + h F(y + h/2 f0)``; returns the evaluation's status."""
     for i in range(y.shape[0]):
         ym[i] = y[i] + 0.5 * h * f0[i]
-    st = state_rate(ym, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body,
-                    loads, ws, fm, nfev)
+    st = _rate(ym, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads, ws,
+               fm, nfev)
     for i in range(y.shape[0]):
         pred[i] = y[i] + h * fm[i]
     return st
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _correct(y, yn, fm, h, H, g, work, secant):
     """One quasi-Newton correction ``yn -= H G(yn)`` (``fm = F((y + yn)/2)``; the
     residual into ``g``), after Broyden's update of ``H`` by the previous correction when
@@ -187,7 +197,7 @@ def _correct(y, yn, fm, h, H, g, work, secant):
     return size, scale
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def broyden_update(H, s, dg, a, b):
     """Broyden's good update of the inverse ``H`` for the step ``s`` that changed the
     residual by ``dg``: ``H += (s - H dg) (s^T H) / (s^T H dg)`` (skipped when the
@@ -210,7 +220,7 @@ def broyden_update(H, s, dg, a, b):
             H[i, j] += c * b[j]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _newton_inverse(ym, fm, h, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree,
                     body, loads, ws, fp, J, H, piv, nfev):
     """``H = (I - h/2 dF/dy)^-1`` at ``ym`` (``fm = F(ym)``), the derivative by forward
@@ -222,8 +232,8 @@ def _newton_inverse(ym, fm, h, drive_vals, nq, slots, free_q, free_u, drive_q, d
         eps = 1.4901161193847656e-08 * max(1.0, abs(ym[j]))
         old = ym[j]
         ym[j] = old + eps
-        st = state_rate(ym, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree,
-                        body, loads, ws, fp, nfev)
+        st = _rate(ym, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads,
+                   ws, fp, nfev)
         ym[j] = old
         if st:
             return st
