@@ -10,8 +10,8 @@ of fixed frames carrying mass and the next joint, a spherical joint below a fixe
 point loads and force elements on fixed frames (those are kept), a joint damper and an
 actuator whose joint's parent is merged, a drive, and the gyroscopic effect off.  Models
 that name frames inside their numbers (contacts, gravity compensation) or close loops are
-not merged.  The ordinary entries' unchecked calls (``kernels.entries.frozen``) refuse any
-other input to the checked route.
+not merged.  The ordinary entries' calls with no dispatch (``kernels.entries.direct``)
+leave any other input to the checked route, arrays they would misread among them.
 """
 import numpy as np
 import pytest
@@ -189,6 +189,50 @@ def test_models_naming_frames_in_their_numbers_are_not_merged(build, monkeypatch
     q, u, ud = state(merged)
     close(merged.forward_dynamics(q, u), full.forward_dynamics(q, u))
     close(merged.effort_array(q, u, ud), full.effort_array(q, u, ud))
+
+
+def unaligned(x):
+    """``x``'s values in a float64 array whose data starts one byte off an 8-byte boundary."""
+    raw = np.zeros(x.size * 8 + 1, np.uint8)
+    out = np.ndarray(x.shape, np.float64, raw.data, offset=1)
+    out[:] = x
+    assert not out.flags.aligned
+    return out
+
+
+def test_the_direct_calls_leave_arrays_they_would_misread_to_the_checked_route():
+    """The compiled entry that the ordinary methods call with no dispatch unboxes its
+    arguments unchecked: an int64 array would be read as float64, a 2-d one overrun, a
+    byte-swapped one read as garbage.  ``inputs.fits`` sends each of them to the checked
+    route, which converts or rejects it as for any caller."""
+    model = robot(loads=True).compile()
+    q, u, ud = state(model)
+    for _ in range(2):                        # the checked call, then the direct one
+        ref = (model.forward_dynamics(q, u), model.effort_array(q, u, ud),
+               model.mass_matrix(q))
+    assert {"auto", "efforts", "mass matrix"} <= set(model._fast_calls)
+    whole = np.round(q * 3)                   # integer values: exact as int64
+    ref_whole = (model.forward_dynamics(whole, u), model.effort_array(whole, u, ud),
+                 model.mass_matrix(whole))
+    as_int = whole.astype(np.int64)
+    assert np.array_equal(model.forward_dynamics(as_int, u), ref_whole[0])
+    assert np.array_equal(model.effort_array(as_int, u, ud), ref_whole[1])
+    assert np.array_equal(model.effort_array(whole, u.astype(">f8"), ud), ref_whole[1])
+    assert np.array_equal(model.mass_matrix(as_int), ref_whole[2])
+    swapped = q.astype(">f8")
+    assert np.array_equal(model.forward_dynamics(swapped, u), ref[0])
+    assert np.array_equal(model.mass_matrix(swapped), ref[2])
+    odd = unaligned(q)
+    assert np.array_equal(model.forward_dynamics(odd, unaligned(u)), ref[0])
+    assert np.array_equal(model.effort_array(q, u, unaligned(ud)), ref[1])
+    assert np.array_equal(model.mass_matrix(odd), ref[2])
+    for column in (q.reshape(-1, 1), q.reshape(1, -1)):
+        with pytest.raises(mb.ModelError, match="expects q of length"):
+            model.forward_dynamics(column, u)
+        with pytest.raises(mb.ModelError, match="expects q of length"):
+            model.mass_matrix(column)
+        with pytest.raises(mb.ModelError):
+            model.effort_array(column, u, ud)
 
 
 def test_closed_loops_are_not_merged():

@@ -15,7 +15,7 @@ from ..errors import ModelError, SimulationError
 from ..kernels import constrained as kc
 from ..kernels import loop_articulated as kla
 from ..kernels.loop_solve import RANK_TOLERANCE
-from .inputs import freeze, plain
+from .inputs import fits, freeze, plain
 
 
 def groups(model):
@@ -94,8 +94,8 @@ def constrained_accelerations(model, q, u, t=0.0, route="jourdain"):
     configuration it hands over to the mass matrix).  One compiled call on the packed
     arrays: float64 arrays as they come, anything else converted and checked first.
     After a call that succeeded, a model without inputs written in Python calls the
-    kernel ``frozen`` from then on (``fast_call``), unchecked: numba refuses any other
-    type, the kernel any other size."""
+    kernel's compiled entry from then on (``fast_call``), with no dispatch: for arrays that
+    pass ``inputs.fits``; the kernel checks their sizes."""
     kernel = (kla.constrained_articulated_packed if route == "articulated"
               else kc.constrained_accelerations_packed)
     packed = (*model._dynamics_full, *model._con_packed)    # (fb, ib, forces, con_int, cf)
@@ -124,17 +124,17 @@ def constrained_accelerations(model, q, u, t=0.0, route="jourdain"):
 
 
 def fast_call(model, q, u, route):
-    """``u'`` by the frozen kernel of a closed mechanism's ``route`` (``freeze``), or
+    """``u'`` by the compiled entry of a closed mechanism's ``route`` (``freeze``), or
     ``None`` when there is none yet, the input is not float64 arrays that fit, or the
     call did not succeed (the caller then takes the checked route)."""
     call = model._fast_calls.get(("closed", route))
-    if call is None:
+    if call is None or not (fits(q) and fits(u)):    # no dispatch: inputs.freeze
         return None
     kernel, fb, ib, forces, con_int, cf, ud = call
     try:
         if kernel(fb, ib, forces, con_int, cf, q, u) == -1:
             return ud.copy()
-    except (TypeError, ZeroDivisionError):
+    except ZeroDivisionError:
         pass
     return None
 

@@ -10,6 +10,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..kernels import packed as kp
+from .inputs import F64, ND, STRIDES
 from .inputs import freeze as _freeze
 from .inputs import plain as _plain
 from .constrained import fast_call as closed_fast_call
@@ -38,13 +39,15 @@ def forward_dynamics(model, q, u, t=0.0, method="auto"):
     ``"auto"`` (the default) takes the fastest at the model's size (``formulation``,
     docs/performance.md)."""
     call = model._fast_calls.get(method)
-    if call is not None:             # float64 arrays that fit: no check in Python (frozen)
+    if (call is not None and type(q) is ND and type(u) is ND and q.dtype is F64
+            and u.dtype is F64 and q.strides == STRIDES and u.strides == STRIDES):
+        # arrays of the compiled type (inputs.fits): its entry, no dispatch (freeze)
         kernel, fb, ib, forces, ud = call
         try:
             if kernel(fb, ib, forces, q, u) == -1:
                 return ud.copy()
-        except (TypeError, ZeroDivisionError):
-            pass                     # any other input, or a failure: the checked route
+        except ZeroDivisionError:
+            pass                     # a failure, or another size: the checked route
     if model._con is not None and method in ("auto", "jourdain", "articulated"):
         # closed loops: G u' = gamma, by the mass matrix or the articulated bodies
         route = loop_route(model, method)
@@ -66,8 +69,9 @@ def forward_dynamics(model, q, u, t=0.0, method="auto"):
 def _accelerations(model, q, u, t, method, key=None):
     """``u'`` by one packed kernel into a new array: float64 arrays as they come, anything
     else converted and checked first.  After a call that succeeded, a model without
-    inputs written in Python calls the kernel ``frozen`` from then on (``_fast_calls``
-    under the ``method`` asked for, ``key``), unchecked: numba refuses any other type."""
+    inputs written in Python calls the kernel's compiled entry from then on
+    (``_fast_calls`` under the ``method`` asked for, ``key``), with no dispatch, for
+    arrays that pass ``inputs.fits``."""
     if method == "jourdain":
         kernel = model._jourdain_kernel
         if kernel is None:                       # its arrays not yet allocated

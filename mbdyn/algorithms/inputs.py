@@ -10,7 +10,7 @@ import numpy as np
 
 from ..errors import ModelError, NonFiniteError, SingularMassMatrixError
 from ..kernels import forces as kf
-from ..kernels.entries import frozen
+from ..kernels.entries import direct
 
 
 def fill(model, q, u, t):
@@ -57,13 +57,29 @@ def plain(x, n):
             and x.flags.c_contiguous and x.flags.writeable)
 
 
+#: what ``fits`` compares against: the ndarray type, float64 (native byte order), the
+#: strides of a contiguous 1-d float64 array
+ND, F64, STRIDES = np.ndarray, np.dtype(np.float64), (8,)
+
+
+def fits(x):
+    """Whether ``x`` is of the type the compiled entries were made for (``freeze``): a
+    numpy array (not a subclass) of native float64, one-dimensional and contiguous.
+    Their sizes the kernels check themselves.  Alignment is not asked (it costs as much
+    as the rest): numba's code reads a float64 with no more than 8-byte alignment
+    assumed, which x86-64 and AArch64 load from any address (tests/test_merging.py runs
+    an unaligned array through).  The hottest methods write this test inline for their
+    arguments: a call costs as much as the test."""
+    return type(x) is ND and x.dtype is F64 and x.strides == STRIDES
+
+
 def freeze(model, key, kernel, packed, args, *rest):
     """After a checked call of ``kernel`` on ``(*packed, *args)`` succeeded: enter
-    ``(kernel frozen for these types, *packed, *rest)`` into the model's fast calls under
-    ``key`` (``kernels.entries.frozen``), when it can be had.  The ordinary per-call
-    methods then call it first, with no check in Python: numba refuses any other type,
-    the kernel any other size."""
-    call = frozen(kernel, (*packed, *args))
+    ``(its compiled entry for these types, *packed, *rest)`` into the model's fast calls
+    under ``key`` (``kernels.entries.direct``), when it can be had.  The ordinary per-call
+    methods then call it first, with no dispatch, once their arguments pass ``fits``;
+    the kernel checks their sizes."""
+    call = direct(kernel, (*packed, *args))
     if call is not None:
         model._fast_calls[key] = (call, *packed, *rest)
 

@@ -12,6 +12,7 @@ from ..errors import NonFiniteError
 from ..kernels import dynamics as kd
 from ..kernels import inverse as ki
 from .inputs import plain as _plain
+from .inputs import F64, ND, STRIDES
 from .inputs import freeze as _freeze
 from ..kernels import packed as kp
 
@@ -32,14 +33,15 @@ def mass_matrix(model, q, t=0.0):
     in one compiled call (``kernels.inverse``: each joint's motion subspace, no full
     Jacobians, O(n depth)) on the merged tree (``compiled.merging``)."""
     call = model._fast_calls.get("mass matrix")
-    if call is not None:             # a float64 array that fits: no check in Python (frozen)
+    if call is not None and type(q) is ND and q.dtype is F64 and q.strides == STRIDES:
+        # an array of the compiled type (inputs.fits): its entry, no dispatch (freeze)
         kernel, fb, ib, forces, shape = call
         M = np.empty(shape)
         try:
             if kernel(fb, ib, forces, q, M) == -1:
                 return M
-        except (TypeError, ZeroDivisionError):
-            pass                     # any other input, or a failure: the checked route
+        except ZeroDivisionError:
+            pass                     # a failure, or another size: the checked route
     M = np.empty((model.nu, model.nu))
     status = None
     if not model._python_inputs and _plain(q, model.nq):

@@ -12,6 +12,7 @@ from ..kernels import dynamics as kd
 from ..kernels import inverse as ki
 from .inputs import plain as _plain
 from .forward_dynamics import ARTICULATED_FROM, METHODS
+from .inputs import F64, ND, STRIDES
 from .inputs import freeze as _freeze
 from .loop_newton_euler import loop_newton_euler_reactions
 from .newton_euler import tree_order
@@ -103,14 +104,17 @@ def effort_array(model, q, u, u_dot, t=0.0):
     compiled call on the merged tree (O(n), ``compiled.merging``; a closed mechanism by
     ``M u' - f`` of its tree)."""
     call = model._fast_calls.get("efforts")
-    if call is not None:             # float64 arrays that fit: no check in Python (frozen)
+    if (call is not None and type(q) is ND and type(u) is ND and type(u_dot) is ND
+            and q.dtype is F64 and u.dtype is F64 and u_dot.dtype is F64
+            and q.strides == STRIDES and u.strides == STRIDES and u_dot.strides == STRIDES):
+        # arrays of the compiled type (inputs.fits): its entry, no dispatch (freeze)
         kernel, fb, ib, forces, nu = call
         tau = np.empty(nu)
         try:
             if kernel(fb, ib, forces, q, u, u_dot, tau) == -1:
                 return tau
-        except (TypeError, ZeroDivisionError):
-            pass                     # any other input, or a failure: the checked route
+        except ZeroDivisionError:
+            pass                     # a failure, or another size: the checked route
     return _efforts(model, model._dynamics, q, u, u_dot, t, "efforts")
 
 
@@ -118,7 +122,7 @@ def _efforts(model, packed, q, u, u_dot, t, key=None):
     """``effort_array`` on the packed tree ``packed``: the merged one, or the full one
     (``model._dynamics_full``), whose joint wrenches ``model._W`` then holds.  After a
     call that succeeded, a model without inputs written in Python calls the kernel
-    ``frozen`` from then on, under ``key`` (``inputs.freeze``)."""
+    by its compiled entry from then on, under ``key`` (``inputs.freeze``)."""
     tau = np.empty(model.nu)
     status = None
     if (model._con is None and not model._python_inputs and _plain(q, model.nq)

@@ -80,8 +80,9 @@ class Model:
         #: drives, function loads or force laws: values Python writes before each compiled
         #: evaluation
         self._python_inputs = bool(self._time_inputs or self._load_functions or self._laws)
-        #: the per-call entries' kernels frozen to their one specialization, with their
-        #: packed arguments, by method (``kernels.entries.frozen``): filled on first use
+        #: the per-call entries' kernels as their one specialization's entry (no
+        #: dispatch), with their packed arguments, by method (``kernels.entries.direct``,
+        #: ``algorithms.inputs.freeze``): filled on first use
         self._fast_calls = {}
         #: controllers in Python and PID integral terms, updated at their sampling
         #: instants between compiled stretches (``integrate.sampled``)
