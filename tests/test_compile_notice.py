@@ -69,8 +69,9 @@ def test_the_check_finds_the_cache_where_numba_keeps_it(tmp_path):
 
 
 def test_an_index_of_other_source_or_another_numba_is_not_a_hit(tmp_path, monkeypatch):
-    """numba stores the source's SHA-256 and its own version in the index: an index
-    written for another source or by another numba does not count."""
+    """numba stores the source's SHA-256 and its own version in the index, and the stamp
+    carries the hash of every kernel module (``kernels.cache``): an index written for
+    another source, another state of the kernels or by another numba does not count."""
     import hashlib
     import pickle
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
@@ -80,9 +81,12 @@ def test_an_index_of_other_source_or_another_numba_is_not_a_hit(tmp_path, monkey
     tag = f"py{sys.version_info.major}{sys.version_info.minor}"
     index = folder / f"evaluate.kinematics_and_loads-30.{tag}.nbi"
     digest = hashlib.sha256(source.read_bytes()).digest()
-    for version, stamp, hit in ((compiling._numba_version(), digest, True),
-                                (compiling._numba_version(), b"x" * 32, False),
-                                ("0.1.0", digest, False)):
+    kernels = compiling.kernels_fingerprint().encode()
+    for version, stamp, hit in ((compiling._numba_version(), digest + kernels, True),
+                                (compiling._numba_version(), digest + b"0" * 64, False),
+                                (compiling._numba_version(), digest, False),
+                                (compiling._numba_version(), b"x" * 32 + kernels, False),
+                                ("0.1.0", digest + kernels, False)):
         index.write_bytes(pickle.dumps(version) + b"(stamp " + stamp + b" overloads)")
         assert compiling.is_cached("evaluate", "kinematics_and_loads") is hit
     assert compiling.is_cached("evaluate", "energies") is False

@@ -16,7 +16,8 @@ start and the first compile begins only after the imports and the model's readin
   cache index files (``*.nbi``) of the kernels the command always calls (``CORE``) where
   numba keeps them (``cache_dir``), without importing numba, and checks that each index
   is of the installed numba and of the current source (its SHA-256, which numba stores in
-  the index); for a command that simulates, also those of the integrator it will use
+  the index, and the hash of every kernel module the entry is stamped with besides,
+  ``kernels.cache``); for a command that simulates, also those of the integrator it will use
   (``--integrator``, or the model file's, read with ``tomllib``).  One missing: the
   notice, with an estimate from ``SECONDS``.
 * ``Watch``, a listener on numba's ``numba:compile`` events for the rest of the command:
@@ -108,6 +109,21 @@ def _numba_version():
         return None
 
 
+def kernels_fingerprint():
+    """``kernels.cache.fingerprint()``, which every kernel's cache entry is stamped with
+    besides its own file's hash, computed here without importing the kernels (whose
+    package imports numba): the same hash of every module of ``mbdyn/kernels``
+    (tests/test_kernel_cache.py holds the two equal)."""
+    if "fingerprint" not in _STATE:
+        digest = hashlib.sha256()
+        folder = PACKAGE / "kernels"
+        for name in sorted(os.listdir(folder)):
+            if name.endswith(".py"):
+                digest.update(name.encode() + b"\0" + (folder / name).read_bytes() + b"\0")
+        _STATE["fingerprint"] = digest.hexdigest()
+    return _STATE["fingerprint"]
+
+
 def is_cached(module, qualname, numba_version=None):
     """Whether numba's cache holds ``mbdyn.kernels.<module>.<qualname>`` compiled from
     the current source by the installed numba (for some argument types)."""
@@ -117,6 +133,7 @@ def is_cached(module, qualname, numba_version=None):
     if folder is None or not os.path.isdir(folder):
         return False
     digest = hashlib.sha256(source.read_bytes()).digest()
+    sources = kernels_fingerprint().encode()
     numba_version = numba_version or _numba_version()
     tag = f"py{sys.version_info.major}{sys.version_info.minor}"
     for name in os.listdir(folder):
@@ -125,7 +142,10 @@ def is_cached(module, qualname, numba_version=None):
             continue
         try:
             with open(os.path.join(folder, name), "rb") as f:
-                if pickle.load(f) == numba_version and digest in f.read():
+                if pickle.load(f) != numba_version:
+                    continue
+                stamp = f.read()
+                if digest in stamp and sources in stamp:
                     return True
         except (OSError, pickle.UnpicklingError, EOFError, ValueError):
             continue

@@ -5,6 +5,12 @@ compiled kernel serves every model.  ``NUMBA_DISABLE_JIT=1`` runs them as plain 
 """
 import warnings
 
+from .cache import install as _install_cache
+
+#: before any kernel module is imported: numba's cache entries stamped with every
+#: kernel module's source, not only their own (``cache``)
+_install_cache()
+
 #: numba's SSA pass reports variables of functions inlined into a loop
 #: (``inline="always"``) as "not in scope" when it compiles the loop: an internal
 #: "pedantic check" of its own IR (``NumbaIRAssumptionWarning``), not about the numbers,
