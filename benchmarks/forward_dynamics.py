@@ -287,7 +287,7 @@ def subkernel_cases(model, q, u, ke):
     ch = (m._M, m._f, m._L, ud)
     nes = (m._mass, m._com, m._inertia, m._parent, m._R, m._r, m._w, m._alpha, m._a, m._JR,
            m._JT, m._anc_ptr, m._anc_idx, m._F, m._N, m._react_joint, m._react_force,
-           m._react_moment, m._A, m._b)
+           m._react_moment, m._A, m._b, m._scratch)
     ke.kinematics_and_loads(*kin)       # leave every workspace as one evaluation does
     kd.jourdain(*jd)
     kd.cholesky_solve(*ch)

@@ -102,7 +102,8 @@ def test_a_non_finite_stage_stops_the_kernel_with_its_state(pendulum):
     no_drives = (np.empty((0, 2), np.int64), np.empty(0), np.zeros(1, np.int64))
     acc, status, _, _ = ka.rk_stretch(*tab.arrays(), 0.0, 1.0, y, f, 10.0, 1e-9, 1e-12,
                                       np.inf, m, np.empty(0), 0, np.empty((0, n)), *no_drives,
-                                      *args, *out, EventPrograms.none())
+                                      *args, *out, EventPrograms.none(),
+                                      ka.stretch_scratch(tab.A, tab.D, n, 0))
     assert (acc, status) == (0, 1)
     with pytest.raises(mb.NonFiniteError, match="non-finite"):
         pendulum.state_derivative(out[6][0], out[6][1:])    # the stage it left

@@ -136,7 +136,8 @@ def test_an_adaptive_stretch_ends_at_a_crossing_with_its_stages(pendulum):
     no_drives = (np.empty((0, 2), np.int64), np.empty(0), np.zeros(1, np.int64))
     acc, status, _, _ = ka.rk_stretch(*tab.arrays(), 0.0, 10.0, y, f, 0.01, 1e-10, 1e-12,
                                       np.inf, m, np.empty(0), 0, np.empty((0, n)), *no_drives,
-                                      *pendulum.loop_arguments(), *out, checks)
+                                      *pendulum.loop_arguments(), *out, checks,
+                                      ka.stretch_scratch(tab.A, tab.D, n, 0))
     theta = out[1][:acc, 0]
     assert status == 0 and 2 < acc < m
     assert theta[-1] <= 0 < theta[-2]                         # the crossing step, and no more

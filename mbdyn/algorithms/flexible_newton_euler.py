@@ -130,7 +130,7 @@ def _system(model, q, u, t, rows):
     kd.newton_euler_system(tree._mass, tree._com, tree._inertia, tree._parent, tree._R,
                            tree._r, tree._w, tree._alpha, tree._a, tree._JR, tree._JT,
                            tree._anc_ptr, tree._anc_idx, F, N, tree._react_joint,
-                           tree._react_force, tree._react_moment, A, b)
+                           tree._react_force, tree._react_moment, A, b, tree._scratch)
     P = model._map.P if model._map is not None else np.eye(model._nux)
     chains = _chains(model)
     nu, nr, nc = model.nu, A.shape[1] - nut, len(chains)

@@ -22,7 +22,7 @@ def _system(model, F, N, A, b):
                            model._R, model._r, model._w, model._alpha, model._a,
                            model._JR, model._JT, model._anc_ptr, model._anc_idx,
                            F, N, model._react_joint, model._react_force,
-                           model._react_moment, A, b)
+                           model._react_moment, A, b, model._scratch)
 
 
 def loop_newton_euler(model, q, u, t=0.0):

@@ -64,7 +64,8 @@ def solve(model, q, u, t, dense=False):
                                model._R, model._r, model._w, model._alpha, model._a,
                                model._JR, model._JT, model._anc_ptr, model._anc_idx,
                                model._F, model._N, model._react_joint,
-                               model._react_force, model._react_moment, A, b)
+                               model._react_force, model._react_moment, A, b,
+                               model._scratch)
         x = _lu_solve(A, b)
         finite = bool(np.all(np.isfinite(x)))
     except np.linalg.LinAlgError:     # singular, or fed NaN/Inf: tell which

@@ -60,14 +60,14 @@ INTEGRATOR_KERNELS = {
 #: cold compile of each entry point with everything below it, CPU seconds on a 2-core
 #: machine (numba 0.68; ``mbdyn warmup``'s first routes, docs/performance.md): the
 #: estimate's source.  Others count ``OTHER`` seconds.
-SECONDS = {"kinematics_and_loads": 3.1, "jourdain_terms": 1.8, "cholesky_solve": 0.9,
-           "rk_stretch": 13.4, "state_derivative_packed": 6.9,
-           "semi_implicit_euler_loop": 3.4, "euler_loop": 3.3, "rk4_loop": 7.9,
-           "implicit_midpoint_loop": 10.0}
+SECONDS = {"kinematics_and_loads": 2.6, "jourdain_terms": 1.3, "cholesky_solve": 0.8,
+           "rk_stretch": 5.1, "state_derivative_packed": 6.9,
+           "semi_implicit_euler_loop": 3.1, "euler_loop": 3.0, "rk4_loop": 3.9,
+           "implicit_midpoint_loop": 6.6}
 OTHER = 5.0
 #: what a simulation compiles besides its integrator (the reactions' Newton-Euler system,
 #: the energies, the drives' programs)
-RUN_EXTRA = 2.0
+RUN_EXTRA = 1.0
 
 _STATE = {"announced": False, "estimate": None}
 _LOCK = threading.Lock()

@@ -195,7 +195,7 @@ class _Stretches:
 
     def _compute(self):
         """One compiled stretch of at most ``self.stretch`` accepted steps."""
-        from ..kernels.adaptive import rk_stretch
+        from ..kernels.adaptive import rk_stretch, stretch_scratch
         plan = self.plan
         m = int(min(self.stretch, plan.budget["max_steps"] - self.steps))
         st = _Stretch(m, self.y.size, self.tab.stages, bool(plan.events),
@@ -207,7 +207,9 @@ class _Stretches:
             *self.coefficients, self.t, plan.t_end, self.y, self.f, self.h_abs, self.rtol,
             plan.atol, plan.max_step, m, self.grid, self.i_eval, self.samples,
             *self.programs, *self.args, st.t_out, st.y_out, st.h_out, st.nfev_out,
-            st.ieval_out, st.K, self.fail, self.nfev, st.checks)
+            st.ieval_out, st.K, self.fail, self.nfev, st.checks,
+            stretch_scratch(self.tab.A, self.tab.D, self.y.size,
+                            self.args[5].size))        # (args[5]: the driven coordinates)
         if _time.process_time() - cpu < STRETCH_CPU and self.stretch < self.most:
             self.stretch *= 2
         return st

@@ -100,9 +100,10 @@ def compiled_chunks(plan, g_old=None):
     ``None``; such a loop stops after a step where a terminal event occurred or a
     condition is not finite, and so does the motion."""
     from ..compiled.programs import EventPrograms
-    from ..kernels.integrators import LOOPS, SCHEMES, STAGES
+    from ..kernels.integrators import LOOPS, SCHEMES, STAGES, loop_scratch
     model, rhs = plan.model, plan.rhs
-    loop = LOOPS[SCHEMES[plan.integrator]]
+    code = SCHEMES[plan.integrator]
+    loop = LOOPS[code]
     args = model.loop_arguments(rhs.method)
     conditions = EventPrograms.of(plan.events)
     checks = EventPrograms.none()
@@ -122,7 +123,8 @@ def compiled_chunks(plan, g_old=None):
             nfev = np.zeros(1, np.int64)
             if conditions is not None:
                 checks = conditions.arguments(g_old, len(tk), False)
-            done, status = loop(h, y, table, *args, out, rates, nfev, tk, checks)
+            done, status = loop(h, y, table, *args, out, rates, nfev, tk, checks,
+                                loop_scratch(y.size, code))
             rhs.evaluations += int(nfev[0])
             failure = None
             if status:

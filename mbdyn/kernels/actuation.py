@@ -21,12 +21,12 @@ gravity (3), setpoint, feed-forward, (frame, mass) of each body the joint carrie
 (a PID's integral term, a sampled controller's effort) and ``feed-forward`` (the computed
 torque) are written between compiled stretches (``integrate.sampled``).
 """
-from numba import njit
 
 from .linalg3 import mat_vec
 from .programs import STACK, evaluate
 from .tables import NO_TABLE, table_eval
 from .views import UNCOUNTED, c_view
+from .internal import internal
 
 TORQUE, MOTOR, PD, PID, HELD = 0, 1, 2, 3, 4
 TYPES = {"torque": TORQUE, "motor": MOTOR, "pd": PD, "pid": PID, "held": HELD}
@@ -40,7 +40,7 @@ MAX_VARS = 32
 PROGRAM_WORK = MAX_VARS + STACK
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def program_value(data, off, t, x, v, qfull, ufull, work):
     """The value of the program stored at ``data[off]`` (layout above) at time ``t``, with
     the law's ``x``, ``v``; ``work``: ``PROGRAM_WORK`` floats."""
@@ -62,7 +62,7 @@ def program_value(data, off, t, x, v, qfull, ufull, work):
     return evaluate(ops, consts, 0, n_ops, t, y, work[MAX_VARS:PROGRAM_WORK])
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def source_value(data, off, mode, t, x, v, qfull, ufull, work):
     """``(value, rate)`` of a source: a constant (rate 0), a table of ``t`` (its slope),
     or a program (rate 0: a program's rate is a second program)."""
@@ -74,14 +74,14 @@ def source_value(data, off, mode, t, x, v, qfull, ufull, work):
     return work[0], work[1]
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def clock(data, off, qfull):
     """The time, from the model's clock entry (0 for an actuator that does not read it)."""
     slot = int(data[off + A_CLOCK])
     return qfull[slot] if slot >= 0 else 0.0
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def gravity_effort(data, off, i, com, R, r, e, c, lever):
     """The effort that balances gravity on the bodies joint ``i`` carries (the
     generalised gravity force of its coordinate, negated): for a revolute joint
@@ -106,7 +106,7 @@ def gravity_effort(data, off, i, com, R, r, e, c, lever):
     return tau
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def actuator_effort(data, off, row, q, u, qfull, ufull, i, com, R, r, e, work):
     """The effort of the actuator whose numbers start at ``data[off]`` on the coordinate
     ``q`` (speed ``u``) of joint ``i`` (world axis ``e``); ``row``: its ``force_int`` row
@@ -147,7 +147,7 @@ def actuator_effort(data, off, row, q, u, qfull, ufull, i, com, R, r, e, work):
     return min(max(tau, -limit), limit)
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def stop_effort(data, off, q, u, acc, want):
     """A joint stop: zero between ``lower`` and ``upper`` (``data[off:off + 4]`` = lower,
     upper, stiffness, damping); beyond a bound by ``d``, ``-(k d + c u)`` pushing back

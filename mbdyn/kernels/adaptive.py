@@ -32,7 +32,7 @@ from .events import step_ends_stretch
 from .routes import finish_step
 from .state_rate import state_rate
 from .programs import STACK, drive_values
-from .views import UNCOUNTED, untracked
+from .views import UNCOUNTED
 
 RK45, DOP853 = 0, 1
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
@@ -260,11 +260,21 @@ def _dense_value(F, y_old, x, out):
         out[i] = y_old[i] + acc
 
 
-@njit(cache=True)
+def stretch_scratch(A, D, n, drives):
+    """The scratch of one ``rk_stretch`` call (a state of ``n`` entries, ``drives``
+    driven coordinates; ``A``, ``D``: the tableau's): the stages ``K``, the new state, a
+    stage's state, the dense polynomial's rows, the programs' stack and the drives'
+    values.  Allocated by the caller: ``rk_stretch`` is compiled without reference
+    counting."""
+    return (np.empty((A.shape[0], n)), np.empty(n), np.empty(n), np.empty((3 + D.shape[0], n)),
+            np.empty(STACK), np.empty((drives, 3)))
+
+
+@njit(cache=True, _nrt=False, no_cfunc_wrapper=True)
 def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_step,
                max_accept, t_eval, i_eval, samples, ops, consts, starts, nq, slots, quats,
                free_q, free_u, drive_q, drive_u, tree, body, loads, ws, out_t, out_y, out_h,
-               out_nfev, out_ieval, out_K, fail, nfev, events):
+               out_nfev, out_ieval, out_K, fail, nfev, events, work):
     """Up to ``max_accept`` accepted steps from ``(t, y)`` (``f`` its derivative, ``h_abs``
     the proposed step) towards ``t_end``.  Accepted step ``k``: ``out_t[k]``,
     ``out_y[k]``, its size ``out_h[k]``, the evaluations so far ``out_nfev[k]``, the
@@ -273,7 +283,9 @@ def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_s
     Output times ``t_eval[i_eval:]`` passed are sampled on the dense output into
     ``samples``.  ``y``, ``f`` end as the last accepted state and its derivative.
     ``events``: the event conditions (``kernels.events``), checked after every step; the
-    stretch ends early after a step where one crossed zero or is not finite.
+    stretch ends early after a step where one crossed zero or is not finite.  ``work``:
+    ``stretch_scratch(A, D, y.size, drive_q.size)`` (the kernel allocates nothing and
+    counts no references: about a second less to compile).
     On failure ``fail`` holds the stage's time, then its state.  Returns
     ``(accepted, status, h_abs, i_eval)``.  A tree's ``quats`` are not projected (the drift
     is reported, as with scipy's solvers); a closed mechanism's state is projected onto its
@@ -285,14 +297,7 @@ def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_s
     # per stage.
     n = y.shape[0]
     stages = B.shape[0] + 1
-    # untracked aliases of the model's arrays: views of them cost no reference counting
-    tree, body, loads, ws = untracked(tree), untracked(body), untracked(loads), untracked(ws)
-    K = np.empty((A.shape[0], n))
-    y_new = np.empty(n)
-    tmp = np.empty(n)
-    F = np.empty((3 + D.shape[0], n))
-    stack = np.empty(STACK)
-    dv = np.empty((drive_q.shape[0], 3))
+    K, y_new, tmp, F, stack, dv = work
     keep_stages = out_K.shape[0]
     check_events = events[3].shape[0] > 0
     exponent = -1.0 / (5.0 if kind == RK45 else 8.0)
@@ -418,7 +423,7 @@ def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_s
     return accepted, 0, h_abs, i_eval
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def dense_step(A, C, D, stages, t_old, y_old, y_new, h, K_step, ops, consts, starts, nq,
                slots, free_q, free_u, drive_q, drive_u, tree, body, loads, ws, nfev):
     """The dense polynomial ``F`` of one accepted step from its stages ``K_step``

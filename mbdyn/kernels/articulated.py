@@ -37,6 +37,7 @@ from .joints import EULER, NU, REVOLUTE, SPHERICAL
 from .motion import cross, row3
 from .spatial import body_inertia, mirror, rigid_upper, shift_upper
 from .views import FUSED, c_view
+from .internal import internal
 
 #: floats of scratch ``articulated_body`` needs: ``ARTICULATED_WORK + 6 n`` for n frames
 #: (``joint_wrenches_tree`` needs 6)
@@ -167,7 +168,7 @@ def _add_shifted_translational_inertia(IA, i, p, rho, T):
             IA[p, 3 + a_, 3 + b_] += IA[i, 3 + a_, 3 + b_]
 
 
-@njit(**FUSED)
+@internal(**FUSED)
 def _bodies(mass, com, inertia, parent, R, r, w, alpha_b, a_b, F, N, IA, pA, cb):
     """The first sweep of ``articulated_body``: every body on its own -- the upper
     triangle of its spatial inertia (``spatial``), its bias force (velocity products and
@@ -200,7 +201,7 @@ def _bodies(mass, com, inertia, parent, R, r, w, alpha_b, a_b, F, N, IA, pA, cb)
                 cb[i, 3 + a_] = a_b[i, a_]
 
 
-@njit(**FUSED)
+@internal(**FUSED)
 def _one_speed(IA, pA, cb, U, Dl, S, i, turns):
     """The joint of frame ``i`` with one speed (motion subspace ``s``, ``S[i, :, 0]``; no
     translation part when it ``turns``), the upper triangle of its articulated inertia
@@ -248,7 +249,7 @@ def _one_speed(IA, pA, cb, U, Dl, S, i, turns):
     return D
 
 
-@njit(**FUSED)
+@internal(**FUSED)
 def articulated_body(mass, com, inertia, parent, kind, ucol, R, r, w, alpha_b, a_b, S, F, N,
                      IA, pA, cb, U, Dl, acc, ud, work):
     """Forward dynamics ``ud`` by the articulated-body algorithm (see the module

@@ -3,12 +3,12 @@ parent exerts on its child (the back-substitution of the tree-order elimination,
 ``articulated.articulated_body``) and the Newton-Euler system's reaction unknowns as
 components of those wrenches.  World components.
 """
-from numba import njit
 
 from .views import UNCOUNTED, c_view
+from .internal import internal
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def joint_wrenches_tree(parent, r, IA, pA, acc, out, work):
     """The wrench each joint's parent exerts on its child, about the child's origin
     (world components), ``out[i] = (force, moment)``, after ``articulated_body``:
@@ -37,7 +37,7 @@ def joint_wrenches_tree(parent, r, IA, pA, acc, out, work):
                 out[i, a_ - 3] = s
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def reaction_components(R, react_joint, react_force, react_moment, wrench, lam):
     """The reaction unknowns ``lambda_k`` of the Newton-Euler system from the joint
     wrenches: component k is the wrench of its joint (the child frame is

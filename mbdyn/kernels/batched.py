@@ -16,7 +16,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 from numba import config
 
-from .integrators import LOOPS
+from .integrators import LOOPS, loop_scratch
 
 #: the workspace entries of a closed mechanism's layouts (26 arrays by the mass matrix, 29
 #: by the articulated bodies: the constraints' eight last) that members share, counted from
@@ -51,13 +51,14 @@ def batched_fixed_step(scheme, h, n_steps, h_last, Y0, table, table_last, nq, sl
         out = np.empty((n_steps + 1, ny))
         count = np.zeros(1, np.int64)
         d, st = loop(h, Y0[i], table, nq, slots, quats, free_q, free_u, drive_q, drive_u,
-                     tree, body, loads, w, out, no_rates, count, no_times, no_events)
+                     tree, body, loads, w, out, no_rates, count, no_times, no_events,
+                     loop_scratch(ny, scheme))
         row = out[d]
         if st == 0 and h_last > 0.0:
             last = np.empty((2, ny))
             d2, st = loop(h_last, out[n_steps], table_last, nq, slots, quats, free_q,
                           free_u, drive_q, drive_u, tree, body, loads, w, last, no_rates,
-                          count, no_times, no_events)
+                          count, no_times, no_events, loop_scratch(ny, scheme))
             d += d2
             row = last[d2]
         Yend[i] = row

@@ -30,6 +30,7 @@ from numba import njit
 from .joints import REVOLUTE
 from .linalg3 import cross_to
 from .views import UNCOUNTED, c_view
+from .internal import internal
 
 POINT, PERP, SLIDE, DIST, COUPLE = 0, 1, 2, 3, 4
 #: rows each primitive contributes
@@ -143,7 +144,7 @@ def constraint_count(con_int):
     return int(sum(ROWS[k] for k in con_int[:, 0])) if len(con_int) else 0
 
 
-@njit(cache=True, _nrt=True)   # allocates: counted even under an uncounted caller
+@internal(cache=True, _nrt=True)   # allocates: counted even under an uncounted caller
 def constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma):
     """Fill the residuals ``phi`` (positions), ``psi`` (their rates), the Jacobian ``G``
@@ -158,7 +159,7 @@ def constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
 ROW_WORK = 57
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
                      R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, work, chosen=None,
                      nchosen=-1, live=False):
@@ -308,7 +309,7 @@ def _apply(ic, ip, P, f, mo, R, r, com, F, N, t1, lever):
             N[i, k] += sign * (mo[k] + t1[k])
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def constraint_wrenches(con_int, con_data, parent, kind_of, axis, R, r, lam, F, N, com, out):
     """The loads the multipliers ``lam`` stand for: each primitive's force and moment on
     its child (at the child's point) and the opposite on its parent, added to the

@@ -33,6 +33,7 @@ from numba import njit
 from .contact_geometry import (FAR, axis, cam_flat, cam_roller, corner, plane_point, pose,
                                segment_point, segments, sphere_box, spheres)
 from .views import UNCOUNTED
+from .internal import internal
 
 #: the force-table kind code of a contact element between shapes (apart from the codes
 #: kernels.forces lists, which are small integers)
@@ -50,7 +51,7 @@ RECORDS = 4
 
 
 # ---------------------------------------------------------------- the force law
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _touch(ia, ib, p, n, dist, off, data, R, r, w, v, com, F, N, acc, want, t):
     """The force of one contact point: ``dist < 0`` pushes frame ``ib`` along ``n`` and
     frame ``ia`` along ``-n`` at the world point ``p``; energy and power into ``acc``."""
@@ -90,7 +91,7 @@ def _touch(ia, ib, p, n, dist, off, data, R, r, w, v, com, F, N, acc, want, t):
         record(acc, p, f)
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def record(acc, p, f):
     """With ``acc`` longer than ``RECORDS``, the touching point ``p`` and the force ``f``
     on its second body appended there (``acc[3]`` counts them; what does not fit is
@@ -107,7 +108,7 @@ def record(acc, p, f):
     acc[3] = k + 1
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _velocity(i, p, r, w, v, out):
     """Velocity of the material point of frame ``i`` at the world point ``p``."""
     if i < 0:
@@ -120,7 +121,7 @@ def _velocity(i, p, r, w, v, out):
     out[2] = v[i, 2] + w[i, 0] * ly - w[i, 1] * lx
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _apply(i, p, f, sign, R, r, com, F, N, lever):
     """``sign * f`` at the world point ``p`` on frame ``i`` (reduced to its centre of
     mass)."""
@@ -138,7 +139,7 @@ def _apply(i, p, f, sign, R, r, com, F, N, lever):
 
 
 # ---------------------------------------------------------------- a pair
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def pair(s1, s2, off, data, R, r, w, v, com, F, N, acc, want, query, t):
     """The contact of the shapes whose records start at ``s1`` and ``s2``: its forces
     (unless ``query``), and the smallest signed distance of its points (``FAR`` for a pair
@@ -192,7 +193,7 @@ def pair(s1, s2, off, data, R, r, w, v, com, F, N, acc, want, query, t):
 
 
 # ---------------------------------------------------------------- the element
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def shape_contacts(off, data, R, r, w, v, com, F, N, acc, want, work):
     """Every touching pair of the contact element at ``data[off]``: its wrenches into
     ``F``, ``N`` and, with ``want``, its energy and power into ``acc``.  ``work``:
@@ -216,7 +217,7 @@ def shape_contacts(off, data, R, r, w, v, com, F, N, acc, want, work):
                work[CONTACT_WORK:CONTACT_WORK + 7 * ns])
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _sweep(ns, off, data, R, r, w, v, com, F, N, acc, want, t, b):
     """Sweep and prune: the shapes' bounding intervals along the axis over which their
     centres spread most, sorted; a pair is tested when its intervals and its bounding
@@ -269,7 +270,7 @@ def _sweep(ns, off, data, R, r, w, v, com, F, N, acc, want, t, b):
                 pair(si, sj, off, data, R, r, w, v, com, F, N, acc, want, False, t)
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _sort(perm, key, m):
     """``perm[0:m]`` the order of ``key[0:m]``, ascending (heapsort: no allocation)."""
     for a in range(m):
@@ -281,7 +282,7 @@ def _sort(perm, key, m):
         _sift(perm, key, 0, end)
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _sift(perm, key, root, end):
     while True:
         child = 2 * root + 1

@@ -11,15 +11,15 @@ gradient of the stored energy ``k delta^(n+1) / (n+1)`` and the energy balance h
 """
 import math
 
-from numba import njit
 
 from .views import UNCOUNTED
+from .internal import internal
 
 #: a distance no contact reaches (a pair that cannot touch)
 FAR = 1e300
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def pose(data, s, R, r, c, A):
     """World centre ``c`` and axes ``A`` of the shape record at ``data[s]`` (see
     ``kernels.contact``: frame at ``s + 1``, position at ``s + 2``, ``C`` at ``s + 5``)."""
@@ -38,19 +38,19 @@ def pose(data, s, R, r, c, A):
                 + R[i, a, 2] * data[s + 11 + b]
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def axis(A, j, out):
     """Local axis ``j`` of the axes ``A`` into ``out``."""
     for a in range(3):
         out[a] = A[3 * a + j]
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _dot(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def spheres(c1, r1, c2, r2, p, n):
     """Two spheres (centres ``c1``, ``c2``): along the line of their centres."""
     L2 = 0.0
@@ -67,7 +67,7 @@ def spheres(c1, r1, c2, r2, p, n):
     return dist
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def plane_point(e, c, g, p):
     """A point ``e`` against the plane through ``c`` with outward normal ``g``: its signed
     distance, and ``p`` amid the point and the plane."""
@@ -77,7 +77,7 @@ def plane_point(e, c, g, p):
     return dist
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def corner(kind, k, c, A, size, g, e, tmp):
     """The ``k``-th point of a shape that can touch a plane of outward normal ``g``: a
     box's corner (``kind`` 3; ``size`` its half sizes), a capsule's end sphere's deepest
@@ -107,7 +107,7 @@ def corner(kind, k, c, A, size, g, e, tmp):
         e[a] += sc * tmp[a]
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def segment_point(c, A, half, x, out):
     """The point of the segment ``c +- half * (local z)`` closest to ``x``."""
     s = (x[0] - c[0]) * A[2] + (x[1] - c[1]) * A[5] + (x[2] - c[2]) * A[8]
@@ -116,7 +116,7 @@ def segment_point(c, A, half, x, out):
         out[a] = c[a] + s * A[3 * a + 2]
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def segments(c1, A1, h1, c2, A2, h2, o1, o2, t):
     """The closest points ``o1``, ``o2`` of two segments ``c +- h (local z)`` (Ericson,
     *Real-Time Collision Detection*, 5.1.9)."""
@@ -139,7 +139,7 @@ def segments(c1, A1, h1, c2, A2, h2, o1, o2, t):
         o2[a] = c2[a] - h2 * A2[3 * a + 2] + tt * d2[a]
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def sphere_box(c, rad, cb, A, h, p, n, t):
     """A sphere (centre ``c``) against a box (centre ``cb``, axes ``A``, half sizes
     ``h``): the box's point nearest the centre or, for a centre inside the box, its
@@ -174,7 +174,7 @@ def sphere_box(c, rad, cb, A, h, p, n, t):
 
 
 # ---------------------------------------------------------------- cams
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def profile(data, cb, phi, out):
     """A cam's radius and its first and second derivatives at the angle ``phi`` (any
     turn) into ``out[0:3]``: the periodic cubic spline of the profile block at ``cb``
@@ -200,7 +200,7 @@ def profile(data, cb, phi, out):
     out[2] = 6.0 * c3 * s + 2.0 * c2
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _cam_slope(data, cb, roller, x, y, phi, t):
     """``(h', h'')`` at ``phi`` of what the cam's contact point maximises: the profile's
     support ``P . (x, y)`` (a flat follower) or ``P . (x, y) - |P|^2 / 2`` (a roller at
@@ -216,7 +216,7 @@ def _cam_slope(data, cb, roller, x, y, phi, t):
     return d1, d2
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _cam_extremum(data, cb, roller, x, y, t):
     """The angle of the cam's contact point (see ``_cam_slope``): the best knot, then a
     safeguarded Newton iteration between its neighbours."""
@@ -249,7 +249,7 @@ def _cam_extremum(data, cb, roller, x, y, t):
     return phi
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def cam_flat(c1, g, o, A, data, cb, p, e, t):
     """A flat follower (the plane through ``c1`` with outward normal ``g``) against a cam
     (centre ``o``, axes ``A``, profile block at ``cb``): the profile's point deepest
@@ -267,7 +267,7 @@ def cam_flat(c1, g, o, A, data, cb, p, e, t):
     return plane_point(e, c1, g, p)
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def cam_roller(c1, rad, o, A, data, cb, p, n, t):
     """A roller (a circle of radius ``rad`` centred at ``c1``, in the cam's plane) against
     a cam: the profile's point closest to the centre; ``n`` from the roller to the cam."""

@@ -15,6 +15,7 @@ from numba.extending import register_jitable
 from .kinematics import cross
 from .linalg3 import cross_to, mat_vec, rotate_tensor
 from .views import UNCOUNTED, c_view
+from .internal import internal
 
 
 @njit(cache=True, inline="always")
@@ -51,7 +52,7 @@ def applied_loads(mass, com, gravity, R, r, load_body, load_point, load_force, l
             N[i, k] += mo[k] + t[k]
 
 
-@njit(cache=True, inline="always")
+@internal(**UNCOUNTED)
 def body_terms(i, com, inertia, R, w, alpha_b, a_b, c, Iw, aG_b, gyro, S3, t1, t2):
     """Per body i, into the given arrays: lever ``c`` (origin -> centre of mass), world
     inertia ``Iw``, bias acceleration of the centre of mass ``aG_b`` and the inertia
@@ -73,7 +74,7 @@ def body_terms(i, com, inertia, R, w, alpha_b, a_b, c, Iw, aG_b, gyro, S3, t1, t
         gyro[k] = t1[k] + t2[k]
 
 
-@njit(cache=True, inline="always")
+@internal(**UNCOUNTED)
 def com_jacobian(i, c, JT, JR, anc_ptr, anc_idx, out):
     """Translation Jacobian of body i's centre of mass over its ancestor columns."""
     for m in range(anc_ptr[i], anc_ptr[i + 1]):
@@ -83,7 +84,7 @@ def com_jacobian(i, c, JT, JR, anc_ptr, anc_idx, out):
         out[2, col] = JT[i, 2, col] + JR[i, 0, col] * c[1] - JR[i, 1, col] * c[0]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def jourdain(mass, com, inertia, has_inertia, R, r, w, alpha_b, a_b, JR, JT, anc_ptr, anc_idx,
              parent, F, N, M, f):
     """Newton-Euler-Jourdain: ``M = sum JT^T m JT + JR^T I JR`` (assembled by the
@@ -138,7 +139,7 @@ def jourdain_terms(mass, com, inertia, has_inertia, R, r, w, alpha_b, a_b, JR, J
                       + JR[i, 0, a_] * fR[0] + JR[i, 1, a_] * fR[1] + JR[i, 2, a_] * fR[2])
 
 
-@njit(cache=True, inline="always")
+@internal(**UNCOUNTED)
 def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc_idx, M, S, IC,
                           scratch):
     """``M`` by the composite-rigid-body algorithm, in world Pluecker coordinates.
@@ -236,7 +237,7 @@ def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc
 LAPACK_CHOLESKY_FROM = 40
 
 
-@njit(cache=True, _nrt=True)
+@internal(cache=True, _nrt=True)
 def _lapack_cholesky(M, L, tiny):
     """``L`` from LAPACK's Cholesky; False if it fails or a pivot is below ``tiny``.
     Counted, explicitly (a callee inherits an uncounted caller's mode): LAPACK's factor
@@ -280,7 +281,7 @@ def cholesky_solve(M, f, L, x):
     return _triangular_solves(L, f, x)
 
 
-@njit(cache=True, inline="always")
+@internal(cache=True, _nrt=False)
 def _triangular_solves(L, f, x):
     """``x`` from ``L L^T x = f`` (``L`` lower triangular); returns -1."""
     n = L.shape[0]
@@ -297,9 +298,14 @@ def _triangular_solves(L, f, x):
     return -1
 
 
-@njit(cache=True)
+#: floats of ``work`` ``newton_euler_system`` needs beyond ``3 nu``
+NEWTON_EULER_WORK = 45
+
+
+@njit(**UNCOUNTED)
 def newton_euler_system(mass, com, inertia, parent, R, r, w, alpha_b, a_b, JR, JT,
-                        anc_ptr, anc_idx, F, N, react_joint, react_force, react_moment, A, b):
+                        anc_ptr, anc_idx, F, N, react_joint, react_force, react_moment, A, b,
+                        work):
     """Assemble the Newton-Euler equations with reaction unknowns, ``A x = b``.
 
     Rows ``6i..6i+2``: Newton for body i at its centre of mass; rows ``6i+3..6i+5``: Euler
@@ -307,23 +313,24 @@ def newton_euler_system(mass, com, inertia, parent, R, r, w, alpha_b, a_b, JR, J
     and the reaction components ``lambda_k`` (column ``nu + k``).  Reaction component k
     belongs to the joint whose child is frame ``react_joint[k]`` and acts on that child at
     its origin with force ``R react_force[k]`` and moment ``R react_moment[k]`` (child
-    components); the parent receives the opposite.
+    components); the parent receives the opposite.  ``work``: ``3 nu +
+    NEWTON_EULER_WORK`` floats of scratch (the kernel allocates nothing).
     """
     n = mass.shape[0]
     nu = JR.shape[2]
+    if work.shape[0] < 3 * nu + NEWTON_EULER_WORK:
+        raise ValueError("newton_euler_system: work holds fewer than 3 nu + 45 floats")
     A[:, :] = 0.0
-    JG = np.zeros((3, nu))
-    c = np.empty(3)
-    cp = np.empty(3)
-    Iw = np.empty((3, 3))
-    S3 = np.empty((3, 3))
-    aG_b = np.empty(3)
-    gyro = np.empty(3)
-    t1 = np.empty(3)
-    t2 = np.empty(3)
-    Fk = np.empty(3)
-    Nk = np.empty(3)
-    lever = np.empty(3)
+    JG = c_view(work, 0, (3, nu))
+    for k in range(3 * nu):
+        work[k] = 0.0
+    at = 3 * nu
+    Iw, S3 = c_view(work, at, (3, 3)), c_view(work, at + 9, (3, 3))
+    c, cp, aG_b, gyro = (c_view(work, at + 18, (3,)), c_view(work, at + 21, (3,)),
+                         c_view(work, at + 24, (3,)), c_view(work, at + 27, (3,)))
+    t1, t2, Fk, Nk = (c_view(work, at + 30, (3,)), c_view(work, at + 33, (3,)),
+                      c_view(work, at + 36, (3,)), c_view(work, at + 39, (3,)))
+    lever = c_view(work, at + 42, (3,))
     for i in range(n):
         body_terms(i, com, inertia, R, w, alpha_b, a_b, c, Iw, aG_b, gyro, S3, t1, t2)
         com_jacobian(i, c, JT, JR, anc_ptr, anc_idx, JG)
@@ -358,7 +365,7 @@ def newton_euler_system(mass, com, inertia, parent, R, r, w, alpha_b, a_b, JR, J
                 A[6 * p + 3 + q, col] += Nk[q] + t1[q]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def joint_wrenches(mass, com, inertia, parent, R, r, w, alpha, a, F, N, out):
     """Inverse dynamics, leaves to root: the force and moment (about the joint origin)
     each parent exerts on its child, given the full accelerations; ``out[i] = (F, N)``.
@@ -392,7 +399,7 @@ def joint_wrenches(mass, com, inertia, parent, R, r, w, alpha, a, F, N, out):
                 out[p, 3 + k] += mp[k]
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def energies(mass, com, inertia, gravity, R, r, w, v):
     """Kinetic energy ``T = sum 1/2 m |v_G|^2 + 1/2 w . I w`` and gravitational potential
     ``V = -sum m g . r_G`` of the whole system."""

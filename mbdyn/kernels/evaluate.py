@@ -17,6 +17,7 @@ from .forces import FORCE_WORK, force_elements
 from .kinematics import KINEMATICS_WORK, walk
 from .motion import MOTION_WORK, motion
 from .views import UNCOUNTED, c_view
+from .internal import internal
 
 
 def scratch_size(n, nu, nuf):
@@ -59,7 +60,7 @@ def kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_
              scratch)
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def loads_at(parent, axis, mass, com, gravity, qfull, ufull, load_body, load_point,
              load_force, load_moment, load_in_body, forces, force_data, R, r, w, v, F, N,
              scratch):
@@ -75,7 +76,7 @@ def loads_at(parent, axis, mass, com, gravity, qfull, ufull, load_body, load_poi
                            v, F, N, force_data[0:0], scratch, shapes)
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def motion_and_loads(tree, body, state, loads, kin, scratch):
     """``kinematics_and_loads`` for the per-call entries, with the kinematics of
     ``motion.motion`` (no full Jacobians; ``S``) and, with the gyroscopic effect switched
@@ -162,7 +163,7 @@ def jourdain_accelerations(tree, body, state, loads, motion, jourdain, scratch):
     return outcome(pivot, ud)
 
 
-@njit(cache=True)
+@internal(cache=True)
 def newton_euler_solution(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                           mass, com, inertia, gravity, qfull, ufull, udfull,
                           load_body, load_point, load_force, load_moment, load_in_body,
@@ -183,7 +184,7 @@ def newton_euler_solution(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc
                                anc_idx, qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S,
                                scratch)
     newton_euler_system(mass, com, inertia, parent, R, r, w, alpha, a, JR, JT, anc_ptr, anc_idx,
-                        F, N, react_joint, react_force, react_moment, A, b)
+                        F, N, react_joint, react_force, react_moment, A, b, scratch)
     return np.linalg.solve(A, b)
 
 
@@ -220,7 +221,7 @@ def articulated_accelerations(tree, body, state, loads, motion, work, ud, scratc
     return outcome(pivot, ud)
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def newton_euler_tree(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                       mass, com, inertia, gravity, qfull, ufull, udfull,
                       load_body, load_point, load_force, load_moment, load_in_body,

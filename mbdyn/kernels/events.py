@@ -15,6 +15,8 @@ evaluated.
 import numpy as np
 from numba import njit
 
+from .internal import internal
+
 from .programs import evaluate
 
 
@@ -31,7 +33,7 @@ def crossed(direction, g_old, g_new):
     return up or down
 
 
-@njit(cache=True, inline="always")
+@internal(cache=True, _nrt=False)
 def step_ends_stretch(events, t, y, row):
     """The conditions at ``(t, y)`` into ``out_g[row]``; true when the loop must stop after
     this step (a condition not finite, or a crossing that Python must handle now)."""
@@ -48,7 +50,7 @@ def step_ends_stretch(events, t, y, row):
     return stop
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def condition_rows(ops, consts, first, last, ts, ys, stack, out):
     """One condition at every row: ``out[i] = g(ts[i], ys[i])``."""
     for i in range(ts.shape[0]):

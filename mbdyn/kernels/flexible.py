@@ -31,6 +31,7 @@ from .flexible_views import (AA, AX, CHAIN, DMAP, EDATA, EINT, FDATA, FF, FINT, 
                              body_views, buffers, jourdain_views, loads_views, motion_views,
                              one, tree_views, two)
 from .views import UNCOUNTED, c_view
+from .internal import internal
 
 #: ``flags`` entries: the stiffening on, tree speeds, first modal entry of ``qfull`` and
 #: ``ufull``, any body's axial stiffness coupled, the map ``P`` not the identity, modal
@@ -60,7 +61,7 @@ def chain_state(qfull, ufull, udfull, chain, D, qm0, um0):
         udfull[chain[c, 1]] = 0.0
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def kinematics_step(h, x, forces):
     """The chains from ``eta``, then the tree's kinematics and loads at the true speeds;
     each body's true angular velocity (body components) kept, the element forces
@@ -92,7 +93,7 @@ def kinematics_step(h, x, forces):
         fwork[k] = 0.0
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def element_step(h, x):
     """The loads and force elements at the flexible bodies' points (true speeds)."""
     fb, ib = buffers(h, x)
@@ -105,7 +106,7 @@ def element_step(h, x):
                    fwork[flags[W_EL]:flags[W_LU]])
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def bias_step(h, x):
     """The bias accelerations (without velocity products when the gyroscopic effect is
     off) and the tree's Jourdain terms; ``M_x``, ``f_x`` start from them (and the
@@ -132,7 +133,7 @@ def bias_step(h, x):
             Mx[i, j] = Mt[i, j] if i < nut and j < nut else 0.0
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def bodies_step(h, x):
     """Each body's ``B^T M_b B`` and ``B^T (Q + element forces)`` into ``M_x``, ``f_x``
     (``B`` only on the frame's ancestor columns and the body's modal ones), then
@@ -223,7 +224,7 @@ def bodies_step(h, x):
                     Ax[x0 + k, col] += ka[k] * b0
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def model_step(h, x, with_mass):
     """The model's ``A = P^T A_x P``, ``f = P^T f_x`` (and ``M = P^T M_x P`` when
     ``with_mass``): copies when ``P`` is the identity."""
@@ -266,7 +267,7 @@ def model_step(h, x, with_mass):
                     Y[p, j] += val * T[e, j]
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def lu_solve(A, b, x, LU):
     """``x = A^-1 b`` by LU with partial pivoting (``LU``: scratch of ``A``'s size).
     Returns -1, or the column where the pivot is exactly zero (a singular matrix, as
@@ -305,7 +306,7 @@ def lu_solve(A, b, x, LU):
     return -1
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def solve_step(h, x):
     """``x = A^-1 f`` (the model's ``u'``); returns as ``lu_solve``."""
     nu = x.shape[0]

@@ -20,6 +20,7 @@ from numba import njit
 from numba.extending import register_jitable
 
 from .views import UNCOUNTED
+from .internal import internal
 
 
 @register_jitable
@@ -48,7 +49,7 @@ def body_work(n):
     return 45 + 18 * n
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def mv(A, off, rows, cols, x, xo, out, oo, scale, transpose):
     """``out[oo:] += scale A x[xo:]`` (``A^T`` when ``transpose``) for the row-major
     ``rows x cols`` matrix at ``A[off]``: every product of the body's terms."""
@@ -74,7 +75,7 @@ def _cross_add(a, ao, b, bo, out, oo, scale):
     out[oo + 2] += scale * (a[ao] * b[bo + 1] - a[ao + 1] * b[bo])
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def body_equations(fd, off, n, eta, ed, omega, g, bias, omega_k, gyroscopic, stiffening,
                    Mb, Q, w):
     """The body's ``Mb`` ((6 + n) x (6 + n)) and generalized forces ``Q`` (6 + n) at
@@ -182,7 +183,7 @@ def body_equations(fd, off, n, eta, ed, omega, g, bias, omega_k, gyroscopic, sti
         Q[r] -= acc
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def axial_row(fd, off, n, eta, out):
     """``out = K_a eta`` (n): the modal rows' coefficient of the frame's ``a_x`` that the
     geometric stiffness moves to the left-hand side."""

@@ -37,7 +37,7 @@ SIGNATURE = types.int64(types.CPointer(types.int64), types.CPointer(types.float6
                         types.int64)
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def call(hook, io, mode):
     """The hook's function on ``io`` in ``mode``, from Python."""
     return call_address(hook[FUNCTION], hook, io, mode)

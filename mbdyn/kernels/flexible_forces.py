@@ -26,6 +26,7 @@ from numba import njit
 
 from .tables import table_eval
 from .views import UNCOUNTED, c_view
+from .internal import internal
 
 LOAD, SPRING_DAMPER, BUSHING, BEARING = 0, 1, 2, 3
 EROW = 11          # entries of an eint row
@@ -118,7 +119,7 @@ def side_state(frame, b, off, fint, edata, qfull, ufull, R, r, w, v, out):
             Rn[i, j] = Ri[i, 0] * rot[j] + Ri[i, 1] * rot[3 + j] + Ri[i, 2] * rot[6 + j]
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def apply(frame, b, off, st, F, N, p, fint, edata, R, r, JR, JT, anc_ptr, anc_idx, fe, qe,
           tmp):
     """Add the force ``F`` and moment ``N`` (world) acting at the world point ``p`` on a
@@ -162,7 +163,7 @@ def apply(frame, b, off, st, F, N, p, fint, edata, R, r, JR, JT, anc_ptr, anc_id
                            + Psi[0, j] * tmp[3] + Psi[1, j] * tmp[4] + Psi[2, j] * tmp[5])
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def element_forces(eint, edata, fint, qfull, ufull, R, r, w, v, JR, JT, anc_ptr, anc_idx, fe,
                    qe, work):
     """Add every element's generalized forces: rigid frames' to ``fe`` (extended speeds),

@@ -27,6 +27,7 @@ from .joints import coordinate_rates
 from .kinematics import walk
 from .loop_solve import PASSAGE_TOLERANCE, RANK_TOLERANCE
 from .views import UNCOUNTED, c_view
+from .internal import internal
 
 #: a projection whose residual stops falling (by half a step) below this is done
 #: (``algorithms.flexible_loops.STALLED``)
@@ -149,7 +150,7 @@ def _svd_views(lw, m, nu):
     return U, s, V, X, at + k * k + k + 2 * nu * k
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def constrained_solve(A, f, G, gamma, lam, held, ud, lw):
     """``ud``, ``lam`` of ``A u' = f + G^T lam``, ``G u' = gamma`` (module docstring);
     returns -1, or the column where the system is singular."""
@@ -193,7 +194,7 @@ def constrained_solve(A, f, G, gamma, lam, held, ud, lw):
     return -1
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def min_norm(G, rhs, held, x, lw):
     """``x``: the minimum-norm solution of ``G x = rhs`` over the kept directions of
     ``G``; returns ``(kept, ratio)`` (``kept_rank``)."""
@@ -221,7 +222,7 @@ def _constraints(h, x):
     return con_views(two(h, CON_INT, h), one(h, CF, x), h[H_NUT])
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def rows_step(h, x, walk_first):
     """The constraint rows at the extended joint-space state (a walk first when
     ``walk_first``: the kinematics there are not the true ones), and the model's
@@ -242,7 +243,7 @@ def rows_step(h, x, walk_first):
                flags[NUT], flags[MAPPED] != 0)
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def constrained_step(h, x):
     """``x = u'`` of the constrained system at the rows of ``rows_step`` (``lam`` in the
     constraints' workspace); returns as ``constrained_solve``."""
@@ -265,7 +266,7 @@ def _place(h, y, nq):
                 flags[UM0])
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def project_step(h, y):
     """Move ``y = [q, u]`` onto the constraints (``algorithms.flexible_loops.project``):
     Newton on the positions with minimum-norm steps through ``q' = N(q) u``, until every

@@ -29,6 +29,7 @@ from .contact import CONTACT_SHAPES, record, shape_contacts
 from .linalg3 import cross_to, mat_t_vec, mat_vec
 from .tables import LINEAR, NO_TABLE, PCHIP, table_eval  # noqa: F401
 from .views import UNCOUNTED
+from .internal import internal
 
 (SPRING_DAMPER, JOINT_SPRING_DAMPER, BUSHING, BEARING, CONTACT_SPHERE, CONTACT_DISK, ACTUATOR,
  JOINT_STOP) = 1, 2, 3, 4, 5, 6, 7, 8
@@ -40,7 +41,7 @@ ROW = 10          # entries of a force_int row
 FORCE_WORK = 74 + PROGRAM_WORK   # floats of scratch ``force_elements`` needs
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _point(i, s, R, r, w, v, p, pv, lever):
     """World position ``p`` and velocity ``pv`` of the point ``s`` (frame components) of
     frame ``i``; the ground (-1) holds still and its components are world ones."""
@@ -56,7 +57,7 @@ def _point(i, s, R, r, w, v, p, pv, lever):
         pv[k] += v[i, k]
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _material_velocity(i, p, r, w, v, out, lever):
     """Velocity of the material point of frame ``i`` at the world point ``p``."""
     if i < 0:
@@ -69,7 +70,7 @@ def _material_velocity(i, p, r, w, v, out, lever):
         out[k] += v[i, k]
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _apply(i, p, f, m, sign, R, r, com, F, N, lever, t):
     """Add ``sign * f`` acting at the world point ``p`` and the moment ``sign * m`` to
     frame ``i``'s loads (reduced to its centre of mass)."""
@@ -84,7 +85,7 @@ def _apply(i, p, f, m, sign, R, r, com, F, N, lever, t):
         N[i, k] += sign * (t[k] + m[k])
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _law(data, spring_off, spring_mode, damper_off, damper_mode, k, c, F0, x, xd, tmp,
          qfull, ufull, work):
     """Tension of a spring-damper law and the potential of its spring part:
@@ -260,7 +261,7 @@ def force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r,
                      pa, va, d, f, lever, t, e1, zero)
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _joint_effort(i, p, e, prismatic, tau, R, r, com, F, N, f, at, zero, lever, t):
     """The effort ``tau`` on the coordinate of joint ``i`` (parent ``p``; ``e`` its axis in
     world components): a force along a prismatic axis or a moment about a revolute one, on
@@ -276,7 +277,7 @@ def _joint_effort(i, p, e, prismatic, tau, R, r, com, F, N, f, at, zero, lever, 
         _apply(p, at, zero, f, -1.0, R, r, com, F, N, lever, t)
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _to_world(i, R, s, out):
     if i < 0:
         for k in range(3):      # element-wise: an array assignment compiles numba's message
@@ -285,7 +286,7 @@ def _to_world(i, R, s, out):
         mat_vec(R[i], s, out)
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _bushing_state(ia, ib, R, w, d, va, vb, x6, xd6, t1, t2, t3, t4):
     """Relative translation and small rotation of frame b in frame a's axes, and their
     rates (``d`` = world offset b - a; ``va``, ``vb`` the points' velocities)."""
@@ -327,7 +328,7 @@ def _bushing_state(ia, ib, R, w, d, va, vb, x6, xd6, t1, t2, t3, t4):
         xd6[3 + q] = t2[q]
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _contact(kind, i, off, data, R, r, w, v, com, F, N, acc, want, pc, vc, n, f, lever, t,
              ax, zero):
     """Compliant contact of a sphere (or a disk's rim) of frame ``i`` with a plane fixed

@@ -17,7 +17,9 @@ Optimization and Nonlinear Equations*, 8.1, Broyden's update).
 """
 import numpy as np
 from numba import njit
-from .state_rate import copy_into, state_rate
+from .state_rate import copy_into
+from .state_rate import state_rate_call as _rate
+from .internal import internal
 
 #: a kept matrix whose iteration contracts more slowly than this is formed again
 REFRESH_RATE = 0.25
@@ -78,25 +80,15 @@ def lu_apply(LU, piv, x):
         x[i] = s / LU[i, i]
 
 
-@njit(cache=True)
-def _rate(y, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body, loads, ws,
-          ydot, nfev):
-    """``state_rate`` compiled once, as a function of its own, for every evaluation of
-    the step: inlined at each of its four call sites it was compiled four times (the
-    loop's first compile about 3 s longer, of 28 s on a busy machine)."""
-    return state_rate(y, drive_vals, nq, slots, free_q, free_u, drive_q, drive_u, tree, body,
-                      loads, ws, ydot, nfev)
-
-
-@njit(cache=True, inline="always")
 def newton_scratch(ny):
     """What ``implicit_midpoint_step`` keeps over steps besides the matrix ``J`` it
     factors: the inverse ``H``, the pivots ``piv`` (``piv[ny]`` is 1 while ``H`` holds an
-    inverse) and four work vectors."""
+    inverse) and four work vectors; allocated by the loop's caller
+    (``integrators.loop_scratch``)."""
     return np.empty((ny, ny)), np.zeros(ny + 1, np.int64), np.empty((4, ny))
 
 
-@njit(cache=True)
+@internal(cache=True)
 def implicit_midpoint_step(y, y1, y2, back, h, drive_start, drive_vals, nq, slots, free_q,
                            free_u, drive_q, drive_u, tree, body, loads, ws, yn, f0, fm, fp,
                            ym, pred, J, H, piv, work, nfev):

@@ -26,12 +26,13 @@ from .motion import cross, motion, row3
 from .packed import FREE_Q, FREE_U, UDFULL, WRONG_SIZE, _scatter, _views
 from .spatial import body_inertia
 from .views import FUSED, UNCOUNTED
+from .internal import internal
 
 #: floats of scratch the two kernels need
 INVERSE_WORK = 48
 
 
-@njit(**FUSED)
+@internal(**FUSED)
 def recursive_newton_euler(mass, com, inertia, parent, kind, ucol, R, r, w, alpha, a, S, F, N,
                            wrench, tau, work):
     """Inverse dynamics from the leaves to the root.  ``alpha``, ``a``: each frame's angular
@@ -79,7 +80,7 @@ def recursive_newton_euler(mass, com, inertia, parent, kind, ucol, R, r, w, alph
             wrench[p, 5] += m2 + x * f1 - y * f0
 
 
-@njit(**FUSED)
+@internal(**FUSED)
 def _ancestor_rows(parent, kind, ucol, r, S, M, i, col, f0, f1, f2, n0, n1, n2):
     """Column ``col`` of ``M`` (and its row) on frame ``i`` and its ancestors: the wrench
     ``(n, f)`` = ``IC_i s`` about ``O_i``, carried up the tree, dotted with each ancestor's
@@ -100,7 +101,7 @@ def _ancestor_rows(parent, kind, ucol, r, S, M, i, col, f0, f1, f2, n0, n1, n2):
         k = p
 
 
-@njit(**FUSED)
+@internal(**FUSED)
 def composite_mass_matrix_s(mass, com, inertia, parent, kind, ucol, R, r, S, IC, M, work):
     """The mass matrix ``M`` (free speeds) by composite rigid bodies: the inertia of the
     subtree of frame ``i`` about ``O_i`` (world axes), a rigid body's, held as its mass
@@ -148,7 +149,7 @@ def composite_mass_matrix_s(mass, com, inertia, parent, kind, ucol, R, r, S, IC,
                            ixz * a0 + iyz * a1 + izz * a2 + hx * l1 - hy * l0)
 
 
-@njit(**FUSED)
+@internal(**FUSED)
 def _add_about_parent(IC, i, p, x, y, z):
     """Add the rigid inertia ``IC[i]`` (``composite_mass_matrix_s``'s layout), moved from
     ``O_i`` to ``O_p`` (``rho = (x, y, z) = O_i - O_p``), to ``IC[p]``: the mass, ``h +

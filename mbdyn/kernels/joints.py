@@ -17,6 +17,7 @@ from numba import njit
 
 from .linalg3 import cross_to, mat_mat, mat_t_vec
 from .views import UNCOUNTED
+from .internal import internal
 
 FIXED, REVOLUTE, PRISMATIC, EULER, SPHERICAL, FREE = 0, 1, 2, 3, 4, 5
 KIND_CODES = {"fixed": FIXED, "revolute": REVOLUTE, "prismatic": PRISMATIC,
@@ -28,7 +29,7 @@ NU = (0, 1, 1, 3, 3, 6)
 MAX_NU = 6
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def rotation_about_axis(axis, angle, out):
     """Rodrigues: rotation by ``angle`` about the unit ``axis``; maps rotated to fixed comps."""
     c = np.cos(angle)
@@ -46,7 +47,7 @@ def rotation_about_axis(axis, angle, out):
     out[2, 2] = c + z * z * k
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def rotation_about_coordinate_axis(k, angle, out):
     """Rotation by ``angle`` about coordinate axis ``k`` (0=x, 1=y, 2=z); = T_k(angle)^T."""
     c = np.cos(angle)
@@ -61,7 +62,7 @@ def rotation_about_coordinate_axis(k, angle, out):
     out[j, i] = s
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def quaternion_to_matrix(q, out):
     """Rotation matrix of the quaternion ``q = (w, x, y, z)``, normalised first.
 
@@ -81,7 +82,7 @@ def quaternion_to_matrix(q, out):
     out[2, 2] = 1.0 - 2.0 * (x * x + y * y)
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def quaternion_rate(q, w, out):
     """``q' = 1/2 q (x) (0, w)`` with ``w`` in the rotated (child) frame.
 
@@ -96,7 +97,7 @@ def quaternion_rate(q, w, out):
     out[3] = 0.5 * (-c * w[0] + b * w[1] + a * w[2])
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def euler_rate_matrix(seq, angles, rates, Hw, hw, Sm, Sv):
     """Relative angular velocity of an Euler-angle joint, child components.
 
@@ -133,7 +134,7 @@ def euler_rate_matrix(seq, angles, rates, Hw, hw, Sm, Sv):
         hw[k] = dc0 * rates[0] + dc1 * rates[1]
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def joint_motion(kind, axis, seq, qj, uj, Rrel, d, Hw, Hv, hw, hv, Sm, Sv):
     """Relative motion of one joint; see the module docstring for the outputs.
     ``Sm`` (4x3x3) and ``Sv`` (8x3) are scratch.  Only the joint's own ``NU[kind]``
@@ -180,7 +181,7 @@ def joint_motion(kind, axis, seq, qj, uj, Rrel, d, Hw, Hv, hw, hv, Sm, Sv):
             Hw[k, 3 + k] = 1.0
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def joint_coordinate_rates(kind, qj, uj, out):
     """Kinematic equations ``q' = N(q) u`` of one joint."""
     if kind == SPHERICAL:

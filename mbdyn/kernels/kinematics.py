@@ -24,9 +24,10 @@ from numba import njit
 from .joints import EULER, MAX_NU, REVOLUTE, SPHERICAL, joint_motion
 from .linalg3 import cross_to, mat_mat, mat_vec
 from .views import UNCOUNTED, c_view
+from .internal import internal
 
 
-@njit(cache=True)
+@internal(cache=True)
 def cross(a, b):
     """``a x b`` as a new array (for code off the hot path)."""
     return np.array((a[1] * b[2] - a[2] * b[1],
@@ -38,7 +39,7 @@ def cross(a, b):
 KINEMATICS_WORK = 5 * 9 + 2 * 3 * MAX_NU + 4 * 9 + 8 * 3 + 25 * 3 + 1
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                        qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S):
     """Motion of every frame and the Jacobians at frame origins (see module docstring).
@@ -53,7 +54,7 @@ def forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_pt
          udfull, R, r, w, v, alpha, a, JR, JT, S, np.empty(KINEMATICS_WORK))
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull, ufull,
          udfull, R, r, w, v, alpha, a, JR, JT, S, work):
     """``forward_kinematics`` in the scratch ``work`` (at least ``KINEMATICS_WORK``

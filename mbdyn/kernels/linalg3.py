@@ -3,26 +3,26 @@
 Inside compiled code, ``A @ x`` on 3x3 arrays calls BLAS and allocates its result; for
 these sizes that costs more than the arithmetic.  Outputs must not alias inputs.
 """
-from numba import njit
 
 from .views import UNCOUNTED
+from .internal import internal
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def mat_vec(A, x, out):
     """``out = A x``."""
     for i in range(3):
         out[i] = A[i, 0] * x[0] + A[i, 1] * x[1] + A[i, 2] * x[2]
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def mat_t_vec(A, x, out):
     """``out = A^T x``."""
     for i in range(3):
         out[i] = A[0, i] * x[0] + A[1, i] * x[1] + A[2, i] * x[2]
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def mat_mat(A, B, out):
     """``out = A B``."""
     for i in range(3):
@@ -30,7 +30,7 @@ def mat_mat(A, B, out):
             out[i, j] = A[i, 0] * B[0, j] + A[i, 1] * B[1, j] + A[i, 2] * B[2, j]
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def rotate_tensor(R, I, tmp, out):
     """``out = R I R^T`` (a body-axes tensor in world axes); ``tmp`` is scratch."""
     for i in range(3):
@@ -41,7 +41,7 @@ def rotate_tensor(R, I, tmp, out):
             out[i, j] = tmp[i, 0] * R[j, 0] + tmp[i, 1] * R[j, 1] + tmp[i, 2] * R[j, 2]
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def cross_to(a, b, out):
     """``out = a x b``."""
     out[0] = a[1] * b[2] - a[2] * b[1]

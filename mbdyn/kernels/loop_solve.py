@@ -14,6 +14,7 @@ from numba import njit
 
 from .rank_qr import add_back_solved, pivoted_back, qr_solve, work_size
 from .views import UNCOUNTED, c_view
+from .internal import internal
 
 #: pivots of the column-pivoted QR of ``Y = L^-1 G^T`` (which follow its singular values)
 #: below this fraction of the first are taken as zero (redundant constraints, or a
@@ -37,7 +38,7 @@ def solve_work(nu, m):
     return max(work_size(nu, m), nu * m + m * m + 4 * m + nu)
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def constrained_solve(M, L, ud, G, gamma, lam, info, work):
     """``ud`` (holding ``M^-1 f`` on entry, ``L`` the Cholesky factor of ``M``) corrected
     to the constrained accelerations; ``lam`` the minimum-norm multipliers.  ``info[0]``:
@@ -109,7 +110,7 @@ def _pivoted_cholesky(A, keep, perm):
     return rank
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _pivoted_solve(L, ud, G, gamma, lam, info, keep, work):
     """The constrained ``ud`` during a run, whose rank ``keep`` is known: ``S = Y^T Y``
     (``L Y = G^T``) factored by Cholesky with complete pivoting (``_pivoted_cholesky``),
@@ -137,7 +138,7 @@ def _pivoted_solve(L, ud, G, gamma, lam, info, keep, work):
     info[1] = A[rank - 1, rank - 1] / np.sqrt(first) if rank and first > 0 else 1.0
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def chosen_solve(L, ud, G, gamma, lam, info, work):
     """A run's constrained ``ud`` (holding ``M^-1 f``) on the rows its last projection
     chose (``_chosen_rows_solve``), when it has chosen as many as the rank it holds.
@@ -214,7 +215,7 @@ def _chosen_rows_solve(L, ud, G, gamma, lam, info, r, Y, A, res, x, z):
     return True
 
 
-@njit(cache=True, _nrt=True)   # allocates: counted even under an uncounted caller
+@internal(cache=True, _nrt=True)   # allocates: counted even under an uncounted caller
 def augmented_solve(M, f, G, gamma, ud, lam, info):
     """The same equations as one least-squares system ``[[M, G^T], [G, 0]] [u', -lam] =
     [f, gamma]`` (minimum norm): for a mass matrix that is only semi-definite.  Returns
@@ -254,7 +255,7 @@ def augmented_solve(M, f, G, gamma, ud, lam, info):
 
 
 
-@njit(cache=True, _nrt=True)   # allocates: counted even under an uncounted caller
+@internal(cache=True, _nrt=True)   # allocates: counted even under an uncounted caller
 def rank_of(G):
     """``(rank, conditioning)``: the singular values of ``G`` above ``RANK_TOLERANCE`` of
     the largest, and the smallest of them over the largest."""

@@ -10,6 +10,7 @@ from numba import njit
 from .loop_solve import RANK_TOLERANCE, ROWS, _pivoted_cholesky
 from .rank_qr import pivoted_back
 from .views import UNCOUNTED, c_view
+from .internal import internal
 
 #: a projection's minimum-norm steps reuse the rows the last pivoted factorisation chose
 #: while their conditioning stays above this fraction of what it was then; below it (the
@@ -23,7 +24,7 @@ def min_norm_work(m):
     return m * m + 3 * m
 
 
-@njit(cache=True, _nrt=True)   # allocates (least squares): counted under an uncounted caller
+@njit(cache=True, _nrt=True, no_cfunc_wrapper=True)  # allocates: counted under any caller
 def min_norm_step(G, rhs, keep, du, info, work):
     """``du``: the minimum-norm solution of ``G du = rhs`` -- during a run (``keep`` >= 0,
     the rank it holds) by ``G_r^T (G_r G_r^T)^-1 rhs_r`` on ``r`` independent rows ``G_r``:
@@ -47,7 +48,7 @@ def min_norm_step(G, rhs, keep, du, info, work):
     return _min_norm_pivoted(G, rhs, keep, du, info, work)
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _min_norm_chosen(G, rhs, r, du, info, work):
     """``min_norm_step`` on the ``r`` rows the last pivoted factorisation chose
     (``info[ROWS + 1:]``, in its pivot order): ``G_r G_r^T`` (``r x r`` instead of ``m x
@@ -102,7 +103,7 @@ def _min_norm_chosen(G, rhs, r, du, info, work):
     return ratio
 
 
-@njit(**UNCOUNTED)
+@internal(**UNCOUNTED)
 def _min_norm_pivoted(G, rhs, keep, du, info, work):
     """``min_norm_step`` with the rank known, the rows chosen by a Cholesky of ``G G^T``
     with complete pivoting, in ``work`` (``m^2 + 3 m`` floats); the rows and the

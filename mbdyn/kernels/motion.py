@@ -13,16 +13,16 @@ same quantities in the same frames as ``walk`` (``kinematics``'s docstring), to 
 """
 import math
 
-from numba import njit
 
 from .joints import FIXED, MAX_NU, NQ, NU, PRISMATIC, REVOLUTE, joint_motion
 from .views import FUSED, c_view
+from .internal import internal
 
 #: floats of scratch ``motion`` needs (the general joints' relative motion)
 MOTION_WORK = 12 + 6 * MAX_NU + 82
 
 
-@njit(**FUSED)
+@internal(**FUSED)
 def mm(a, b):
     """``a b`` of 3x3 matrices held row by row in 9-tuples."""
     return (a[0] * b[0] + a[1] * b[3] + a[2] * b[6], a[0] * b[1] + a[1] * b[4] + a[2] * b[7],
@@ -32,33 +32,33 @@ def mm(a, b):
             a[6] * b[2] + a[7] * b[5] + a[8] * b[8])
 
 
-@njit(**FUSED)
+@internal(**FUSED)
 def mv(a, x, y, z):
     """``a (x, y, z)`` of a 3x3 matrix held in a 9-tuple."""
     return (a[0] * x + a[1] * y + a[2] * z, a[3] * x + a[4] * y + a[5] * z,
             a[6] * x + a[7] * y + a[8] * z)
 
 
-@njit(**FUSED)
+@internal(**FUSED)
 def cross(a, b):
     """``a x b`` of 3-tuples."""
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
-@njit(**FUSED)
+@internal(**FUSED)
 def row3(A, i):
     """``A[i]`` of an (n, 3) array as a 3-tuple."""
     return (A[i, 0], A[i, 1], A[i, 2])
 
 
-@njit(**FUSED)
+@internal(**FUSED)
 def mat9(A, i):
     """``A[i]`` of an (n, 3, 3) array as a 9-tuple, row by row."""
     return (A[i, 0, 0], A[i, 0, 1], A[i, 0, 2], A[i, 1, 0], A[i, 1, 1], A[i, 1, 2],
             A[i, 2, 0], A[i, 2, 1], A[i, 2, 2])
 
 
-@njit(**FUSED)
+@internal(**FUSED)
 def rodrigues(x, y, z, angle):
     """The rotation by ``angle`` about the unit axis ``(x, y, z)``, as ``joints.
     rotation_about_axis`` writes it, in a 9-tuple."""
@@ -69,7 +69,7 @@ def rodrigues(x, y, z, angle):
             z * x * k - y * s, z * y * k + x * s, c + z * z * k)
 
 
-@njit(**FUSED)
+@internal(**FUSED)
 def _general(i, kd, seq, axis, qfull, ufull, udfull, k0, j0, J, rates, S, work):
     """A joint of any kind by ``joints.joint_motion``: ``Ri`` (9-tuple), the origin's
     offset ``J d`` and, in world axes, the relative angular velocity and acceleration and
@@ -109,7 +109,7 @@ def _general(i, kd, seq, axis, qfull, ufull, udfull, k0, j0, J, rates, S, work):
             mv(J, v0, v1, v2), mv(J, dv0, dv1, dv2))
 
 
-@njit(**FUSED)
+@internal(**FUSED)
 def motion(parent, kind, axis, seq, pos, C, qoff, uoff, qfull, ufull, udfull, R, r, w, v,
            alpha, a, S, work, rates):
     """Every frame's ``R``, ``r`` and its joint's columns of ``S`` (world axes, parents

@@ -296,7 +296,7 @@ def _state_rates(fb, ib, t, y, ydot):
     return -1
 
 
-@njit(cache=True)
+@njit(cache=True, no_cfunc_wrapper=True)
 def newton_euler_solution_packed(fb, ib, t, forces, q, u, A, b):
     """Scatter ``q``, ``u``, then ``evaluate.newton_euler_solution`` on packed arrays, the
     dense system in ``A`` (6n x 6n) and ``b`` (6n): they are not in the packed buffers,

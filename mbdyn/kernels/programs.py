@@ -19,7 +19,7 @@ from numba import njit
 STACK = 64
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False, no_cfunc_wrapper=True)  # the compiled loops take it so
 def evaluate(ops, consts, first, last, t, y, stack):
     """The value at ``(t, y)`` of the program ``ops[first:last]`` (``stack``: scratch space
     of ``STACK`` values)."""

@@ -34,7 +34,7 @@ def accelerations(tree, body, loads, ws, ud):
     raise NotImplementedError("compiled code only")
 
 
-@overload(accelerations, jit_options={"_nrt": False})
+@overload(accelerations, jit_options={"_nrt": False, "no_cfunc_wrapper": True})
 def _accelerations_route(tree, body, loads, ws, ud):
     """The formulation is chosen when the loop is compiled, by the workspace's type: 18
     arrays (``M``, ``f``, ``L``, scratch last) for ``M u' = f``, 26 (the same and the
@@ -113,7 +113,7 @@ def finish_step(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_
     raise NotImplementedError("compiled code only")
 
 
-@overload(finish_step, jit_options={"_nrt": False})
+@overload(finish_step, jit_options={"_nrt": False, "no_cfunc_wrapper": True})
 def _finish_step_route(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q, drive_u,
                        tree, loads, ws):
     """Chosen by the workspace's layout, as ``accelerations``: a tree only normalises; a

@@ -18,12 +18,12 @@ from numba.np.arrayobj import make_array, populate_array
 #: double pendulum's evaluation.  Such a kernel must not allocate (``np.empty``, ``copy``,
 #: ``np.linalg``) and must not return an array: it works in the arrays and scratch it is
 #: given, and may call counted kernels that allocate and free inside themselves.
-UNCOUNTED = {"cache": True, "_nrt": False}
+UNCOUNTED = {"cache": True, "_nrt": False, "no_cfunc_wrapper": True}
 #: ``UNCOUNTED`` for the per-call dynamics' arithmetic (``motion``, ``spatial``, the
 #: articulated bodies, inverse dynamics, composite rigid bodies): a product and a sum may
 #: be fused into one rounding (``a * b + c`` as an FMA where the processor has it), the
 #: only licence of fast-math taken -- NaN and Inf keep their meaning, sums their order
-FUSED = {"cache": True, "_nrt": False, "fastmath": {"contract"}}
+FUSED = {"cache": True, "_nrt": False, "fastmath": {"contract"}, "no_cfunc_wrapper": True}
 
 
 def _view(context, builder, view_type, src, data, shape):

@@ -1,0 +1,50 @@
+"""Kernels that only compiled code calls: compiled without an entry from Python.
+
+numba gives every compiled function two wrappers besides its code: one that Python calls
+(it unboxes each argument from a Python object and boxes the result) and one that C calls.
+A helper of the kinematics or of the composite inertias is only ever called from other
+compiled functions, which call its code directly; its wrappers are compiled, optimised,
+machine-coded and cached for nothing, and for a function of twenty arrays the Python
+wrapper is most of the work (``docs/performance.md``, "Cold and warm start": 0.5 s of the
+README's first command for its eleven helpers).
+
+``internal`` compiles a function without either wrapper.  Called from Python, such a
+function would run a null entry (numba crashes the process), so its dispatcher never
+registers an entry for Python calls: a call from Python reaches ``_compile_for_args``,
+which raises ``TypeError`` naming the kernel.  ``tests/test_internal_kernels.py`` checks
+that no Python code of the package, its tests or benchmarks calls one.
+"""
+from numba.core import config
+from numba.core.registry import CPUDispatcher
+
+
+class InternalDispatcher(CPUDispatcher):
+    """A dispatcher whose specializations compiled callers link, with no Python entry."""
+
+    def add_overload(self, cres):
+        # the specialization for compiled callers (type inference, linking), without
+        # the entry in the table Python calls go through
+        self.overloads[tuple(cres.signature.args)] = cres
+
+    def _compile_for_args(self, *args, **kws):
+        name = f"{self.py_func.__module__}.{self.py_func.__qualname__}"
+        raise TypeError(f"{name} is an internal kernel (mbdyn.kernels.internal): it has no "
+                        "entry from Python; call it from compiled code, or call "
+                        f"{name}.py_func for the pure-Python original")
+
+
+def internal(cache=False, **options):
+    """Decorator like ``numba.njit(cache=..., **options)`` for a function only compiled
+    code calls (module docstring)."""
+    targetoptions = dict(options, nopython=True, no_cpython_wrapper=True,
+                         no_cfunc_wrapper=True)
+
+    def decorate(function):
+        if config.DISABLE_JIT:
+            return function
+        dispatcher = InternalDispatcher(py_func=function, locals={},
+                                        targetoptions=targetoptions)
+        if cache:
+            dispatcher.enable_caching()
+        return dispatcher
+    return decorate
