@@ -7,7 +7,14 @@ import subprocess
 import sys
 import textwrap
 
+import pytest
+from numba.core import config
+
 from mbdyn.kernels import internal as ki
+
+#: with NUMBA_DISABLE_JIT=1 the kernels are plain Python functions: nothing to refuse
+compiled_only = pytest.mark.skipif(config.DISABLE_JIT,
+                                   reason="NUMBA_DISABLE_JIT=1: no compiled kernels")
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 KERNELS = os.path.join(ROOT, "mbdyn", "kernels")
@@ -96,6 +103,7 @@ def test_the_scan_sees_a_python_call(tmp_path):
         str(path), False)
 
 
+@compiled_only
 def test_a_python_call_is_refused_with_the_kernel_named():
     """In a child process (a call that ran would crash it): the kernel is compiled (or
     loaded from the cache) as a compiled caller's callee first, then called from Python."""
@@ -128,6 +136,7 @@ def test_a_python_call_is_refused_with_the_kernel_named():
     assert "py_func: -0.295520206661" in done.stdout       # -sin(0.3)
 
 
+@compiled_only
 def test_the_decorator_compiles_without_either_wrapper():
     options = {}
 
