@@ -2,7 +2,7 @@
 each feature's first use.
 
     python benchmarks/first_start.py [--warm 3] [--cold 1] [--source DIR]
-    python benchmarks/first_start.py --features [NAME ...] [--source DIR]
+    python benchmarks/first_start.py --features [NAME ...] [--shared] [--source DIR]
 
 Copies the package (``mbdyn/`` of ``--source``, default this checkout) and the model into a
 temporary directory, so that the cold runs start from an empty numba cache without
@@ -30,7 +30,9 @@ received no cache file), then the same command again warm, from that cache.  Col
 warm is about what compiling costs; "kernels" counts the compiled entry points numba
 wrote to the cache (its index files).  The machine's load shows in the wall times; compare CPU times, and
 compare against a baseline measured in the same session (``--source`` of another
-checkout, e.g. a ``git worktree`` of an older commit).
+checkout, e.g. a ``git worktree`` of an older commit).  ``--features --shared`` runs the
+features in order on one cache instead, as a newcomer meets them: each one's cold figure
+is what its first use adds to the ones before.
 """
 from __future__ import annotations
 
@@ -139,11 +141,15 @@ def write_chain(tmp, folder):
         f.write(namespace["MODELS"]["chain"])
 
 
-def measure_features(source, names=None, n_warm=1):
+def measure_features(source, names=None, n_warm=1, shared=False):
     """``{feature: (kernels, cold wall, cold cpu, warm wall, warm cpu)}``: each feature
     cold in a fresh process with an empty numba cache of its own, then ``n_warm`` times
-    warm from that cache (medians)."""
+    warm from that cache (medians).  ``shared``: one cache for all, the features in
+    ``FEATURES``' order (the README's command first), as a newcomer meets them: each
+    cold figure is then what that feature's first use adds, and "kernels" counts the
+    cache's index files so far."""
     out = {}
+    cache = None
     with tempfile.TemporaryDirectory(prefix="mbdyn-first-use-") as tmp:
         shutil.copytree(os.path.join(source, "mbdyn"), os.path.join(tmp, "mbdyn"),
                         ignore=shutil.ignore_patterns("__pycache__"))
@@ -154,7 +160,8 @@ def measure_features(source, names=None, n_warm=1):
         for name, line in FEATURES:
             if names and not any(n.lower() in name.lower() for n in names):
                 continue
-            cache = tempfile.mkdtemp(prefix="cache-", dir=tmp)
+            if cache is None or not shared:
+                cache = tempfile.mkdtemp(prefix="cache-", dir=tmp)
             scratch = tempfile.mkdtemp(prefix="scratch-", dir=tmp)
             write_chain(tmp, scratch)
             args = ["-m", "mbdyn", *[w.format(tmp=scratch) for w in line]]
@@ -182,10 +189,13 @@ def main(argv=None):
     parser.add_argument("--features", nargs="*", metavar="NAME",
                         help="time each feature's cold first use instead (FEATURES; names "
                              "by any part, default all)")
+    parser.add_argument("--shared", action="store_true",
+                        help="with --features: one numba cache for all the features, in "
+                             "order (what each one's first use adds after the ones before)")
     args = parser.parse_args(argv)
     if args.features is not None:
         rows = measure_features(os.path.abspath(args.source), args.features,
-                                max(args.warm, 1))
+                                max(args.warm, 1), args.shared)
         print(f"{os.cpu_count()} cores, Python {sys.version.split()[0]}, "
               f"source {os.path.abspath(args.source)}\n")
         print("| feature (first use) | kernels | cold wall (s) | cold CPU (s) | warm CPU (s) |")
