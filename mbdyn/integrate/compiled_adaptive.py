@@ -128,6 +128,7 @@ class _Stretches:
             self.rtol = 100 * np.finfo(float).eps
         self.t, self.y = plan.t0, plan.y0.copy()
         self.args = model.loop_arguments(plan.rhs.method)
+        self.drives = self.args[5].size          # the driven coordinates (``drive_q``)
         self.f, self.h_abs = self._first_step()
         self.start_evaluations = plan.rhs.evaluations
         self.dense_args = self.args[:2] + self.args[3:]   # dense_step takes no quaternions
@@ -208,8 +209,7 @@ class _Stretches:
             plan.atol, plan.max_step, m, self.grid, self.i_eval, self.samples,
             *self.programs, *self.args, st.t_out, st.y_out, st.h_out, st.nfev_out,
             st.ieval_out, st.K, self.fail, self.nfev, st.checks,
-            stretch_scratch(self.tab.A, self.tab.D, self.y.size,
-                            self.args[5].size))        # (args[5]: the driven coordinates)
+            stretch_scratch(self.tab.A, self.tab.D, self.y.size, self.drives))
         if _time.process_time() - cpu < STRETCH_CPU and self.stretch < self.most:
             self.stretch *= 2
         return st

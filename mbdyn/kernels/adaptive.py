@@ -32,7 +32,7 @@ from .events import step_ends_stretch
 from .routes import finish_step
 from .state_rate import state_rate
 from .programs import STACK, drive_values
-from .views import UNCOUNTED
+from .views import CACHED, UNCOUNTED
 
 RK45, DOP853 = 0, 1
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
@@ -270,7 +270,7 @@ def stretch_scratch(A, D, n, drives):
             np.empty(STACK), np.empty((drives, 3)))
 
 
-@njit(cache=True, _nrt=False, no_cfunc_wrapper=True)
+@njit(**UNCOUNTED)
 def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_step,
                max_accept, t_eval, i_eval, samples, ops, consts, starts, nq, slots, quats,
                free_q, free_u, drive_q, drive_u, tree, body, loads, ws, out_t, out_y, out_h,
@@ -423,7 +423,7 @@ def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_s
     return accepted, 0, h_abs, i_eval
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(**CACHED)
 def dense_step(A, C, D, stages, t_old, y_old, y_new, h, K_step, ops, consts, starts, nq,
                slots, free_q, free_u, drive_q, drive_u, tree, body, loads, ws, nfev):
     """The dense polynomial ``F`` of one accepted step from its stages ``K_step``

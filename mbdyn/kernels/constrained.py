@@ -31,7 +31,7 @@ from .loop_solve import (ROWS, augmented_solve, chosen_solve, constrained_solve,
                          solve_work)
 from .min_norm import min_norm_step
 from .packed import WRONG_SIZE, _scatter, _views
-from .views import UNCOUNTED, c_view, untracked
+from .views import CACHED, UNCOUNTED, c_view, untracked
 from .internal import internal
 
 #: the projection stops when every position residual is below this (metres for points,
@@ -154,7 +154,7 @@ def project_state(y, nq, slots, quats, free_q, free_u, tree, state, motion, con,
     return steps
 
 
-@njit(cache=True, _nrt=True, no_cfunc_wrapper=True)
+@njit(_nrt=True, **CACHED)
 def project_state_call(y, nq, slots, quats, free_q, free_u, tree, state, motion, con, scratch):
     """``project_state`` as a compiled entry point, for Python (one state) and the compiled
     loops (``routes.finish_step``).  Counted, explicitly: it allocates, and a callee
@@ -163,7 +163,7 @@ def project_state_call(y, nq, slots, quats, free_q, free_u, tree, state, motion,
                          scratch)
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(**CACHED)
 def constraint_state(tree, state, motion, con, scratch):
     """The kinematics at the joint-space state, then the constraint rows (Python's view
     of ``phi``, ``psi``, ``G``, ``gamma``)."""

@@ -29,7 +29,7 @@ from numba import njit
 
 from .joints import REVOLUTE
 from .linalg3 import cross_to
-from .views import UNCOUNTED, c_view
+from .views import CACHED, UNCOUNTED, c_view
 from .internal import internal
 
 POINT, PERP, SLIDE, DIST, COUPLE = 0, 1, 2, 3, 4
@@ -309,7 +309,7 @@ def _apply(ic, ip, P, f, mo, R, r, com, F, N, t1, lever):
             N[i, k] += sign * (mo[k] + t1[k])
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(**CACHED)
 def constraint_wrenches(con_int, con_data, parent, kind_of, axis, R, r, lam, F, N, com, out):
     """The loads the multipliers ``lam`` stand for: each primitive's force and moment on
     its child (at the child's point) and the opposite on its parent, added to the

@@ -14,7 +14,7 @@ from numba.extending import register_jitable
 
 from .kinematics import cross
 from .linalg3 import cross_to, mat_vec, rotate_tensor
-from .views import UNCOUNTED, c_view
+from .views import CACHED, UNCOUNTED, c_view
 from .internal import internal
 
 
@@ -84,7 +84,7 @@ def com_jacobian(i, c, JT, JR, anc_ptr, anc_idx, out):
         out[2, col] = JT[i, 2, col] + JR[i, 0, col] * c[1] - JR[i, 1, col] * c[0]
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(**CACHED)
 def jourdain(mass, com, inertia, has_inertia, R, r, w, alpha_b, a_b, JR, JT, anc_ptr, anc_idx,
              parent, F, N, M, f):
     """Newton-Euler-Jourdain: ``M = sum JT^T m JT + JR^T I JR`` (assembled by the
@@ -319,7 +319,8 @@ def newton_euler_system(mass, com, inertia, parent, R, r, w, alpha_b, a_b, JR, J
     n = mass.shape[0]
     nu = JR.shape[2]
     if work.shape[0] < 3 * nu + NEWTON_EULER_WORK:
-        raise ValueError("newton_euler_system: work holds fewer than 3 nu + 45 floats")
+        raise ValueError("newton_euler_system: work holds fewer than 3 nu + NEWTON_EULER_WORK "
+                         "floats")
     A[:, :] = 0.0
     JG = c_view(work, 0, (3, nu))
     for k in range(3 * nu):
@@ -365,7 +366,7 @@ def newton_euler_system(mass, com, inertia, parent, R, r, w, alpha_b, a_b, JR, J
                 A[6 * p + 3 + q, col] += Nk[q] + t1[q]
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(**CACHED)
 def joint_wrenches(mass, com, inertia, parent, R, r, w, alpha, a, F, N, out):
     """Inverse dynamics, leaves to root: the force and moment (about the joint origin)
     each parent exerts on its child, given the full accelerations; ``out[i] = (F, N)``.
@@ -399,7 +400,7 @@ def joint_wrenches(mass, com, inertia, parent, R, r, w, alpha, a, F, N, out):
                 out[p, 3 + k] += mp[k]
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(**CACHED)
 def energies(mass, com, inertia, gravity, R, r, w, v):
     """Kinetic energy ``T = sum 1/2 m |v_G|^2 + 1/2 w . I w`` and gravitational potential
     ``V = -sum m g . r_G`` of the whole system."""

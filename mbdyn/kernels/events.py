@@ -15,6 +15,8 @@ evaluated.
 import numpy as np
 from numba import njit
 
+from .views import CACHED
+
 from .internal import internal
 
 from .programs import evaluate
@@ -50,7 +52,7 @@ def step_ends_stretch(events, t, y, row):
     return stop
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(**CACHED)
 def condition_rows(ops, consts, first, last, ts, ys, stack, out):
     """One condition at every row: ``out[i] = g(ts[i], ys[i])``."""
     for i in range(ts.shape[0]):

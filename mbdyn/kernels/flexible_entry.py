@@ -30,14 +30,14 @@ from .flexible import bias_step, bodies_step, element_step, kinematics_step, mod
     solve_step
 from .flexible_loops import constrained_step, project_step, rows_step
 from .flexible_views import FUNCTION, HOOK, NQ, NU, SWITCH, call_address, pointer_view
-from .views import UNCOUNTED
+from .views import CACHED, UNCOUNTED
 
 ACCEL, TERMS, PROJECT = 0, 1, 2
 SIGNATURE = types.int64(types.CPointer(types.int64), types.CPointer(types.float64),
                         types.int64)
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(**CACHED)
 def call(hook, io, mode):
     """The hook's function on ``io`` in ``mode``, from Python."""
     return call_address(hook[FUNCTION], hook, io, mode)

@@ -21,6 +21,7 @@ from .events import step_ends_stretch
 from .implicit_midpoint import implicit_midpoint_step, newton_scratch
 from .routes import finish_step
 from .state_rate import coordinate_rates_into, copy_into, state_rate, state_rate_call
+from .views import UNCOUNTED
 
 EULER, SEMI_IMPLICIT_EULER, RK4, IMPLICIT_MIDPOINT = 0, 1, 2, 3
 SCHEMES = {"euler": EULER, "semi-implicit-euler": SEMI_IMPLICIT_EULER, "rk4": RK4,
@@ -110,10 +111,10 @@ def loop_scratch(ny, scheme):
             np.empty((n, n))) + newton_scratch(n)
 
 
-#: the loops' compile options: no reference counting (their arrays are the caller's,
-#: ``loop_scratch``), so no count is kept for any array they view -- their compile about
-#: 0.5 s shorter than with counting and ``views.untracked`` views -- and no C wrapper
-LOOP = {"cache": True, "nogil": True, "_nrt": False, "no_cfunc_wrapper": True}
+#: the loops' compile options: uncounted (their arrays are the caller's, ``loop_scratch``),
+#: so no count is kept for any array they view -- their compile about 0.5 s shorter than
+#: with counting and ``views.untracked`` views -- and releasing the GIL
+LOOP = dict(UNCOUNTED, nogil=True)
 
 
 # One compiled loop per scheme, so that a run compiles only its own scheme's step (a loop

@@ -4,8 +4,8 @@ numba gives every compiled function two wrappers besides its code: one that Pyth
 (it unboxes each argument from a Python object and boxes the result) and one that C calls.
 A helper of the kinematics or of the composite inertias is only ever called from other
 compiled functions, which call its code directly; its wrappers are compiled, optimised,
-machine-coded and cached for nothing, and for a function of twenty arrays the Python
-wrapper is most of the work (``docs/performance.md``, "Cold and warm start": 0.5 s of the
+machine-coded and cached for nothing (for a function of twenty arrays the Python wrapper
+is a quarter of its compile; ``docs/performance.md``, "Fourth round": 0.45 s of the
 README's first command for its eleven helpers).
 
 ``internal`` compiles a function without either wrapper.  Called from Python, such a

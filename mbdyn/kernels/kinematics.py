@@ -23,7 +23,7 @@ from numba import njit
 
 from .joints import EULER, MAX_NU, REVOLUTE, SPHERICAL, joint_motion
 from .linalg3 import cross_to, mat_mat, mat_vec
-from .views import UNCOUNTED, c_view
+from .views import CACHED, UNCOUNTED, c_view
 from .internal import internal
 
 
@@ -39,7 +39,7 @@ def cross(a, b):
 KINEMATICS_WORK = 5 * 9 + 2 * 3 * MAX_NU + 4 * 9 + 8 * 3 + 25 * 3 + 1
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(**CACHED)
 def forward_kinematics(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx,
                        qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S):
     """Motion of every frame and the Jacobians at frame origins (see module docstring).

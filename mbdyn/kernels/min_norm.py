@@ -9,7 +9,7 @@ from numba import njit
 
 from .loop_solve import RANK_TOLERANCE, ROWS, _pivoted_cholesky
 from .rank_qr import pivoted_back
-from .views import UNCOUNTED, c_view
+from .views import CACHED, UNCOUNTED, c_view
 from .internal import internal
 
 #: a projection's minimum-norm steps reuse the rows the last pivoted factorisation chose
@@ -24,7 +24,7 @@ def min_norm_work(m):
     return m * m + 3 * m
 
 
-@njit(cache=True, _nrt=True, no_cfunc_wrapper=True)  # allocates: counted under any caller
+@njit(_nrt=True, **CACHED)   # allocates: counted under any caller
 def min_norm_step(G, rhs, keep, du, info, work):
     """``du``: the minimum-norm solution of ``G du = rhs`` -- during a run (``keep`` >= 0,
     the rank it holds) by ``G_r^T (G_r G_r^T)^-1 rhs_r`` on ``r`` independent rows ``G_r``:

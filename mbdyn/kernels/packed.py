@@ -32,7 +32,7 @@ from .evaluate import (jourdain_accelerations, motion_and_loads, newton_euler_so
                        newton_euler_tree, outcome)
 from .forces import ROW
 from .joints import coordinate_rates
-from .views import UNCOUNTED, c_view, far_view, untracked
+from .views import CACHED, UNCOUNTED, c_view, far_view, untracked
 
 #: what a packed entry returns for an argument of the wrong size (before it reads it)
 WRONG_SIZE = -3
@@ -296,7 +296,7 @@ def _state_rates(fb, ib, t, y, ydot):
     return -1
 
 
-@njit(cache=True, no_cfunc_wrapper=True)
+@njit(**CACHED)
 def newton_euler_solution_packed(fb, ib, t, forces, q, u, A, b):
     """Scatter ``q``, ``u``, then ``evaluate.newton_euler_solution`` on packed arrays, the
     dense system in ``A`` (6n x 6n) and ``b`` (6n): they are not in the packed buffers,

@@ -13,13 +13,15 @@ integers (an actuator's program stored among its element's numbers, ``kernels.ac
 import numpy as np
 from numba import njit
 
+from .views import UNCOUNTED
+
 (CONST, TIME, ADD, MUL, POW, SIN, COS, TAN, EXP, LOG, ASIN, ACOS, ATAN, SINH, COSH, TANH,
  ABS, ATAN2, VAR, SQRT, SIGN, MIN, MAX) = range(23)
 #: the deepest stack a program may need
 STACK = 64
 
 
-@njit(cache=True, _nrt=False, no_cfunc_wrapper=True)  # the compiled loops take it so
+@njit(**UNCOUNTED)  # allocates nothing: the uncounted loops and Python share one compile
 def evaluate(ops, consts, first, last, t, y, stack):
     """The value at ``(t, y)`` of the program ``ops[first:last]`` (``stack``: scratch space
     of ``STACK`` values)."""

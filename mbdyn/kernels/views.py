@@ -11,6 +11,11 @@ from numba.core.imputils import impl_ret_untracked
 from numba.extending import intrinsic
 from numba.np.arrayobj import make_array, populate_array
 
+#: ``njit`` options of every kernel: cached on disk, and without the wrapper numba adds
+#: for calls from C (no kernel is used as a first-class function; ``cfunc`` entries, as
+#: ``flexible_entry``'s, make their own).  The kernels only compiled code calls have no
+#: Python wrapper either (``internal``).
+CACHED = {"cache": True, "no_cfunc_wrapper": True}
 #: ``njit`` options of the kernels an evaluation runs through: compiled without numba's
 #: reference counting (its ``_nrt=False``).  Every array a compiled function holds --
 #: argument, view, tuple member -- otherwise costs a call to increment its count and one to
@@ -18,12 +23,12 @@ from numba.np.arrayobj import make_array, populate_array
 #: double pendulum's evaluation.  Such a kernel must not allocate (``np.empty``, ``copy``,
 #: ``np.linalg``) and must not return an array: it works in the arrays and scratch it is
 #: given, and may call counted kernels that allocate and free inside themselves.
-UNCOUNTED = {"cache": True, "_nrt": False, "no_cfunc_wrapper": True}
+UNCOUNTED = dict(CACHED, _nrt=False)
 #: ``UNCOUNTED`` for the per-call dynamics' arithmetic (``motion``, ``spatial``, the
 #: articulated bodies, inverse dynamics, composite rigid bodies): a product and a sum may
 #: be fused into one rounding (``a * b + c`` as an FMA where the processor has it), the
 #: only licence of fast-math taken -- NaN and Inf keep their meaning, sums their order
-FUSED = {"cache": True, "_nrt": False, "fastmath": {"contract"}, "no_cfunc_wrapper": True}
+FUSED = dict(UNCOUNTED, fastmath={"contract"})
 
 
 def _view(context, builder, view_type, src, data, shape):
