@@ -52,7 +52,7 @@ def applied_loads(mass, com, gravity, R, r, load_body, load_point, load_force, l
             N[i, k] += mo[k] + t[k]
 
 
-@internal(**UNCOUNTED)
+@internal(**UNCOUNTED, forceinline=True)
 def body_terms(i, com, inertia, R, w, alpha_b, a_b, c, Iw, aG_b, gyro, S3, t1, t2):
     """Per body i, into the given arrays: lever ``c`` (origin -> centre of mass), world
     inertia ``Iw``, bias acceleration of the centre of mass ``aG_b`` and the inertia
@@ -74,7 +74,7 @@ def body_terms(i, com, inertia, R, w, alpha_b, a_b, c, Iw, aG_b, gyro, S3, t1, t
         gyro[k] = t1[k] + t2[k]
 
 
-@internal(**UNCOUNTED)
+@internal(**UNCOUNTED, forceinline=True)
 def com_jacobian(i, c, JT, JR, anc_ptr, anc_idx, out):
     """Translation Jacobian of body i's centre of mass over its ancestor columns."""
     for m in range(anc_ptr[i], anc_ptr[i + 1]):
@@ -139,7 +139,7 @@ def jourdain_terms(mass, com, inertia, has_inertia, R, r, w, alpha_b, a_b, JR, J
                       + JR[i, 0, a_] * fR[0] + JR[i, 1, a_] * fR[1] + JR[i, 2, a_] * fR[2])
 
 
-@internal(**UNCOUNTED)
+@internal(**UNCOUNTED, forceinline=True)
 def composite_mass_matrix(mass, com, inertia, parent, R, r, JR, JT, anc_ptr, anc_idx, M, S, IC,
                           scratch):
     """``M`` by the composite-rigid-body algorithm, in world Pluecker coordinates.
@@ -281,7 +281,7 @@ def cholesky_solve(M, f, L, x):
     return _triangular_solves(L, f, x)
 
 
-@internal(cache=True, _nrt=False)
+@internal(cache=True, _nrt=False, forceinline=True)
 def _triangular_solves(L, f, x):
     """``x`` from ``L L^T x = f`` (``L`` lower triangular); returns -1."""
     n = L.shape[0]

@@ -35,7 +35,7 @@ def crossed(direction, g_old, g_new):
     return up or down
 
 
-@internal(cache=True, _nrt=False)
+@internal(cache=True, _nrt=False, forceinline=True)
 def step_ends_stretch(events, t, y, row):
     """The conditions at ``(t, y)`` into ``out_g[row]``; true when the loop must stop after
     this step (a condition not finite, or a crossing that Python must handle now)."""

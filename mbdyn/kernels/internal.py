@@ -8,7 +8,10 @@ machine-coded and cached for nothing (for a function of twenty arrays the Python
 is a quarter of its compile; ``docs/performance.md``, "Fourth round": 0.45 s of the
 README's first command for its eleven helpers).
 
-``internal`` compiles a function without either wrapper.  Called from Python, such a
+``internal`` compiles a function without either wrapper.  A helper moved out of its
+callers' numba inlining (``inline="always"`` compiles it at every call site) takes
+``forceinline=True``: compiled once by numba, its code inlined by LLVM into each caller, so
+that runs pay no call.  Called from Python, such a
 function would run a null entry (numba crashes the process), so its dispatcher never
 registers an entry for Python calls: a call from Python reaches ``_compile_for_args``,
 which raises ``TypeError`` naming the kernel.  ``tests/test_internal_kernels.py`` checks
