@@ -68,13 +68,13 @@ def close_by_mass_matrix(pivot, tree, state, motion, jourdain, con, scratch, liv
         # a run: only the rows its last projection chose, and the solve on them
         _constraint_rows(con_int, con_data, tree[8], tree[6], tree[7], qfull, ufull,
                          udfull, R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch,
-                         info[ROWS + 1:], int(info[ROWS]))
+                         info[ROWS + 1:], int(info[ROWS]), False)
         if chosen_solve(L, ud, G, gamma, lam, info, scratch):
             return _finite(ud)
         info[ROWS] = -1.0            # no longer independent: every row, pivoted, until the
                                      # next projection chooses again
     _constraint_rows(con_int, con_data, tree[8], tree[6], tree[7], qfull, ufull, udfull,
-                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch, None, -1, live)
+                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch, phi[:0], -1, live)
     if pivot >= 0:
         for k in range(ud.shape[0]):
             ud[k] = f[k]
@@ -127,7 +127,8 @@ def project_state(y, nq, slots, quats, free_q, free_u, tree, state, motion, con,
         if anc_ptr.shape[0] == 0:        # the articulated-body layout: no full Jacobians
             constrained_jacobians(con_int, parent, kind, ucol, r, S, JR, JT)
         _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
-                         R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch)
+                         R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch, phi[:0],
+                         -1, False)
         if residual_norm(phi) <= PROJECTION_TOLERANCE:
             break
         if steps == PROJECTION_ITERATIONS:

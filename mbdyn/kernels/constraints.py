@@ -152,7 +152,7 @@ def constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
     accelerations in ``alpha``, ``a``: free speed rates zero, drives' rates given)."""
     _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull, R, r, w, v,
                      alpha, a, JR, JT, phi, psi, G, gamma,
-                     np.empty(ROW_WORK + G.shape[0] * G.shape[1]))
+                     np.empty(ROW_WORK + G.shape[0] * G.shape[1]), phi[:0], -1, False)
 
 
 #: floats of scratch ``_constraint_rows`` takes besides ``G``'s size
@@ -161,12 +161,13 @@ ROW_WORK = 57
 
 @internal(**UNCOUNTED)
 def _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
-                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, work, chosen=None,
-                     nchosen=-1, live=False):
+                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, work, chosen, nchosen,
+                     live):
     """``constraint_rows`` in the scratch ``work`` (one allocation by the caller: the
-    vectors below are views of it, which cost no allocation each).  Given ``chosen``, only
-    the primitives holding one of the rows ``chosen[:nchosen]`` (row numbers, as floats)
-    are evaluated, the other rows left zero (a run solves on the rows it last chose).
+    vectors below are views of it, which cost no allocation each).  With ``nchosen`` >= 0,
+    only the primitives holding one of the rows ``chosen[:nchosen]`` (row numbers, as
+    floats) are evaluated, the other rows left zero (a run solves on the rows it last
+    chose); with ``nchosen`` -1, every row (``chosen`` unread: ``phi[:0]`` will do).
     With ``live``, the primitives whose rows are zero at every state (``con_int[:, 5]``
     0: ``compiled.constraint_packing.moves``) are not evaluated: their ``G`` rows and
     ``gamma`` are zero, their ``phi`` and ``psi`` set to zero too (the accelerations'
@@ -192,7 +193,7 @@ def _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
     row = 0
     for m in range(con_int.shape[0]):
         kind, ip, ic = con_int[m, 0], con_int[m, 1], con_int[m, 2]
-        if chosen is not None and not _holds_chosen(row, ROWS[kind], chosen, nchosen):
+        if nchosen >= 0 and not _holds_chosen(row, ROWS[kind], chosen, nchosen):
             row += ROWS[kind]
             continue
         if live and con_int[m, 5] == 0:

@@ -237,7 +237,7 @@ def rows_step(h, x, walk_first):
         walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull,
              ufull, udfull, R, r, w, v, alpha, a, JR, JT, S, scratch)
     _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull, R, r, w,
-                     v, alpha, a, JR, JT, phi, psi, Gx, gamma, scratch)
+                     v, alpha, a, JR, JT, phi, psi, Gx, gamma, scratch, phi[:0], -1, False)
     flags = one(h, FLAGS, h)
     model_rows(Gx, two(h, GM, x), one(h, PPTR, h), one(h, PIDX, h), one(h, PVAL, x),
                flags[NUT], flags[MAPPED] != 0)

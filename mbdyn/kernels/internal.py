@@ -14,10 +14,12 @@ callers' numba inlining (``inline="always"`` compiles it at every call site) tak
 that runs pay no call.  Called from Python, such a
 function would run a null entry (numba crashes the process), so its dispatcher never
 registers an entry for Python calls: a call from Python reaches ``_compile_for_args``,
-which raises ``TypeError`` naming the kernel.  ``tests/test_internal_kernels.py`` checks
+which raises ``TypeError`` naming the kernel.  A compiled caller's constant arguments are
+typed as their types, not as literal values, so that a kernel compiles once per argument
+types (four copies of the constraint rows, 13 s, in a closed loop's first run before).  ``tests/test_internal_kernels.py`` checks
 that no Python code of the package, its tests or benchmarks calls one.
 """
-from numba.core import config
+from numba.core import config, types
 from numba.core.registry import CPUDispatcher
 
 
@@ -28,6 +30,13 @@ class InternalDispatcher(CPUDispatcher):
         # the specialization for compiled callers (type inference, linking), without
         # the entry in the table Python calls go through
         self.overloads[tuple(cres.signature.args)] = cres
+
+    def get_call_template(self, args, kws):
+        # one specialization per argument types: a constant argument (``-1``, ``False``)
+        # would otherwise compile its own copy per value, each as costly as the first
+        args = tuple(types.unliteral(a) for a in args)
+        kws = {k: types.unliteral(a) for k, a in kws.items()}
+        return super().get_call_template(args, kws)
 
     def _compile_for_args(self, *args, **kws):
         name = f"{self.py_func.__module__}.{self.py_func.__qualname__}"

@@ -194,7 +194,7 @@ def close_loops(tree, state, motion, work, ud, con, scratch, live):
     con_int, con_data, phi, psi, G, gamma, lam, info = con
     constrained_jacobians(con_int, parent, kind, ucol, r, S, JR, JT)
     _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
-                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch, None, -1, live)
+                     R, r, w, v, alpha, a, JR, JT, phi, psi, G, gamma, scratch, phi[:0], -1, live)
     m, nu, n = G.shape[0], G.shape[1], parent.shape[0]
     for i in range(m):
         lam[i] = 0.0
