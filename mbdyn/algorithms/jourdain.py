@@ -107,6 +107,12 @@ def jourdain_packed(model, q, u, t):
     return q, u
 
 
+#: up to this many speeds the check at rest factors ``M`` (microseconds: the kernels every
+#: run compiles for its conditioning report) even where runs take the articulated
+#: route, whose packed entry point would otherwise be compiled for the check alone
+CHECK_BY_CHOLESKY = 60
+
+
 def check_at_rest(model, q, t=0.0):
     """Raise what ``forward_dynamics(q, 0, t)`` raises -- ``SingularMassMatrixError``
     or ``NonFiniteError`` -- by the same Cholesky solve of ``M u' = f``, called on the
@@ -114,7 +120,7 @@ def check_at_rest(model, q, t=0.0):
     this way the check needs no compiled entry point of its own (a first run compiles
     less)."""
     q, u = model._state(q, np.zeros(model.nu))
-    if model.formulation("auto") == "articulated":
+    if model.formulation("auto") == "articulated" and model.nu > CHECK_BY_CHOLESKY:
         # O(n) where runs take that route anyway: the Cholesky factor of M costs O(n^3)
         # (minutes at 10,000 speeds); a failure is reported exactly as below
         model.forward_dynamics(q, u, t, method="articulated")

@@ -144,22 +144,21 @@ class _Stretches:
                      else STRETCH_MOST)
 
     def _derivative(self, t, y):
-        """``y'`` at ``(t, y)``: without drives by the stretches' own compiled stage
-        (``kernels.adaptive.stage``, the same arguments: no entry point of its own to
-        compile), else by ``Model.state_derivative`` (drives evaluated in Python, as
-        before: the same numbers); an evaluation that fails is repeated there, which
-        raises the precise error."""
+        """``y'`` at ``(t, y)`` by the stretches' own compiled stage
+        (``kernels.adaptive.stage``, the same arguments, the drives by the same compiled
+        programs as every later stage: no entry point of its own to compile; for a closed
+        mechanism with a drive that was 4 s of its first run); an evaluation that fails is
+        repeated by ``Model.state_derivative``, which raises the precise error."""
+        from ..kernels.adaptive import stage
+        from ..kernels.programs import STACK
         self.plan.rhs.evaluations += 1
-        if not self.model._time_inputs:
-            from ..kernels.adaptive import stage
-            from ..kernels.programs import STACK
-            nq, slots, _, free_q, free_u, drive_q, drive_u, *arrays = self.args
-            ydot = np.empty(y.size)
-            status = stage(float(t), y, *self.programs, np.empty(STACK), np.empty((0, 3)), nq,
-                           slots, free_q, free_u, drive_q, drive_u, *arrays, ydot,
-                           np.zeros(1, np.int64))
-            if not status:
-                return ydot
+        nq, slots, _, free_q, free_u, drive_q, drive_u, *arrays = self.args
+        ydot = np.empty(y.size)
+        status = stage(float(t), y, *self.programs, np.empty(STACK),
+                       np.empty((self.drives, 3)), nq, slots, free_q, free_u, drive_q, drive_u,
+                       *arrays, ydot, np.zeros(1, np.int64))
+        if not status:
+            return ydot
         return self.model.state_derivative(t, y, self.plan.rhs.method)
 
     def _first_step(self):
