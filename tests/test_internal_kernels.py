@@ -152,3 +152,28 @@ def test_the_decorator_compiles_without_either_wrapper():
         ki.InternalDispatcher = original
     assert options["no_cpython_wrapper"] and options["no_cfunc_wrapper"]
     assert options["_nrt"] is False
+
+
+@compiled_only
+@pytest.mark.parametrize("constants", [False, True])
+def test_constant_arguments_compile_once_unless_asked(constants):
+    """A compiled caller's constants (``-1``, ``2``, ``True``) are typed as literal values:
+    numba would compile the callee once per value (four copies of the closed loop's
+    constraint rows).  An internal kernel compiles once per argument types, unless it
+    asks for its constants (``motion``'s ``rates``)."""
+    from numba import njit
+
+    @ki.internal(constants=constants)
+    def scaled(x, k, flag):
+        return x * k if flag else x
+
+    @njit
+    def first(x):
+        return scaled(x, -1, True)
+
+    @njit
+    def second(x):
+        return scaled(x, 2, False)
+
+    assert first(3.0) == -3.0 and second(3.0) == 3.0
+    assert len(scaled.overloads) == (2 if constants else 1)

@@ -126,3 +126,29 @@ def test_ordinary_api_takes_any_numbers_and_names_what_is_wrong():
     bad[0] = np.nan
     with pytest.raises(mb.NonFiniteError, match=m.speeds[0]):
         m.effort_array(t.q, bad, ud, t.t)
+
+
+@pytest.mark.parametrize("seed", [3, 7, 11])
+@pytest.mark.parametrize("bad", [np.nan, np.inf])
+def test_mass_matrix_is_finite_or_refused_and_exactly_symmetric(seed, bad):
+    """``mass_matrix`` checks only the diagonal for NaN and Inf (``composite_mass_matrix_s``:
+    whatever spoils an entry spoils the diagonal entries of the speeds it joins): with one
+    coordinate at a time NaN or Inf, on trees of every joint kind, the matrix it returns is
+    finite everywhere, or it refuses with ``NonFiniteError``; and it is exactly symmetric
+    (the lower triangle mirrored)."""
+    t = cached_tree(seed)
+    m = t.model
+    M = m.mass_matrix(t.q, t.t)
+    assert np.array_equal(M, M.T)
+    assert rel(M, m._mass_matrix(t.q, t.t, m._jourdain_terms)) < 1e-13
+    refused = 0
+    for k in range(m.nq):
+        q = t.q.copy()
+        q[k] = bad
+        try:
+            M = m.mass_matrix(q, t.t)
+        except mb.NonFiniteError:
+            refused += 1
+            continue
+        assert np.isfinite(M).all(), (m.coordinates[k], M)
+    assert refused > 0

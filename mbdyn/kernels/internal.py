@@ -16,8 +16,9 @@ function would run a null entry (numba crashes the process), so its dispatcher n
 registers an entry for Python calls: a call from Python reaches ``_compile_for_args``,
 which raises ``TypeError`` naming the kernel.  A compiled caller's constant arguments are
 typed as their types, not as literal values, so that a kernel compiles once per argument
-types (four copies of the constraint rows, 13 s, in a closed loop's first run before).  ``tests/test_internal_kernels.py`` checks
-that no Python code of the package, its tests or benchmarks calls one.
+types (four copies of the constraint rows, 13 s, in a closed loop's first run before),
+unless it asks for its constants (``constants=True``).  ``tests/test_internal_kernels.py``
+checks that no Python code of the package, its tests or benchmarks calls one.
 """
 from numba.core import config, types
 from numba.core.registry import CPUDispatcher
@@ -31,11 +32,15 @@ class InternalDispatcher(CPUDispatcher):
         # the entry in the table Python calls go through
         self.overloads[tuple(cres.signature.args)] = cres
 
+    #: compiled once per constant value of its arguments (``internal(constants=True)``)
+    by_constant = False
+
     def get_call_template(self, args, kws):
         # one specialization per argument types: a constant argument (``-1``, ``False``)
         # would otherwise compile its own copy per value, each as costly as the first
-        args = tuple(types.unliteral(a) for a in args)
-        kws = {k: types.unliteral(a) for k, a in kws.items()}
+        if not self.by_constant:
+            args = tuple(types.unliteral(a) for a in args)
+            kws = {k: types.unliteral(a) for k, a in kws.items()}
         return super().get_call_template(args, kws)
 
     def _compile_for_args(self, *args, **kws):
@@ -45,9 +50,11 @@ class InternalDispatcher(CPUDispatcher):
                         f"{name}.py_func for the pure-Python original")
 
 
-def internal(cache=False, **options):
+def internal(cache=False, constants=False, **options):
     """Decorator like ``numba.njit(cache=..., **options)`` for a function only compiled
-    code calls (module docstring)."""
+    code calls (module docstring).  With ``constants``, a caller's constant arguments
+    select a specialization of their own (a flag that removes a branch's work where the
+    kernel is hot: ``motion``'s ``rates``)."""
     targetoptions = dict(options, nopython=True, no_cpython_wrapper=True,
                          no_cfunc_wrapper=True)
 
@@ -56,6 +63,7 @@ def internal(cache=False, **options):
             return function
         dispatcher = InternalDispatcher(py_func=function, locals={},
                                         targetoptions=targetoptions)
+        dispatcher.by_constant = constants
         if cache:
             dispatcher.enable_caching()
         return dispatcher

@@ -21,7 +21,7 @@ import numpy as np
 
 from .dynamics import cholesky_solve
 from .evaluate import motion_and_loads, outcome
-from .joints import NU
+from .joints import NU, REVOLUTE
 from .motion import cross, motion, row3
 from .packed import FREE_Q, FREE_U, UDFULL, WRONG_SIZE, _scatter, _views
 from .spatial import body_inertia
@@ -80,20 +80,21 @@ def recursive_newton_euler(mass, com, inertia, parent, kind, ucol, R, r, w, alph
             wrench[p, 5] += m2 + x * f1 - y * f0
 
 
-@internal(**FUSED)
+@internal(forceinline=True, **FUSED)
 def _ancestor_rows(parent, kind, ucol, r, S, M, i, col, f0, f1, f2, n0, n1, n2):
-    """Column ``col`` of ``M`` (and its row) on frame ``i`` and its ancestors: the wrench
-    ``(n, f)`` = ``IC_i s`` about ``O_i``, carried up the tree, dotted with each ancestor's
-    motion subspace."""
+    """Row ``col`` of ``M`` left of the diagonal (an ancestor's speeds come first), on
+    frame ``i`` and its ancestors: the wrench ``(n, f)`` = ``IC_i s`` about ``O_i``, carried
+    up the tree, dotted with each ancestor's motion subspace (frame ``i``'s own speeds
+    after ``col`` too: the mirror overwrites them)."""
     k = i
     while k >= 0:
         ck = ucol[k]
-        if ck >= 0:
+        if ck >= 0 and kind[k] == REVOLUTE:      # S = (e, 0) about O_k: half the products
+            M[col, ck] = S[k, 0, 0] * n0 + S[k, 1, 0] * n1 + S[k, 2, 0] * n2
+        elif ck >= 0:
             for l_ in range(NU[kind[k]]):
-                s = (S[k, 0, l_] * n0 + S[k, 1, l_] * n1 + S[k, 2, l_] * n2
-                     + S[k, 3, l_] * f0 + S[k, 4, l_] * f1 + S[k, 5, l_] * f2)
-                M[ck + l_, col] = s
-                M[col, ck + l_] = s
+                M[col, ck + l_] = (S[k, 0, l_] * n0 + S[k, 1, l_] * n1 + S[k, 2, l_] * n2
+                                   + S[k, 3, l_] * f0 + S[k, 4, l_] * f1 + S[k, 5, l_] * f2)
         p = parent[k]
         if p >= 0:                   # the wrench about O_p: moment + (O_k - O_p) x force
             x, y, z = r[k, 0] - r[p, 0], r[k, 1] - r[p, 1], r[k, 2] - r[p, 2]
@@ -108,8 +109,11 @@ def composite_mass_matrix_s(mass, com, inertia, parent, kind, ucol, R, r, S, IC,
     ``m``, first moment ``h = m c`` and inertia about ``O_i`` (``IC[i, 0, :4]``: ``m, h``;
     ``IC[i, 1]``: ``xx, xy, xz, yy, yz, zz``; ``IC`` a workspace); for each free speed
     ``k`` of frame ``i``, the wrench ``IC_i S_k`` moved up to every ancestor ``j`` gives
-    the row ``M[l, k] = S_l . W`` of ``j``'s speeds ``l``.  ``work``: ``INVERSE_WORK``
-    floats (not read)."""
+    the row ``M[l, k] = S_l . W`` of ``j``'s speeds ``l``; the lower triangle, mirrored.
+    A NaN or Inf anywhere in ``M`` shows on its diagonal: ``IC_i``, ``S_k`` and the
+    transports that make ``M[l, k]`` make ``M[k, k]`` and ``M[l, l]`` too (and a NaN times
+    zero is NaN), and ``|M[l, k]| <= sqrt(M[l, l] M[k, k])`` for the rest, ``M`` being
+    positive semi-definite.  ``work``: ``INVERSE_WORK`` floats (not read)."""
     n = mass.shape[0]
     for i in range(n):               # each body about its own origin
         c, Iw = body_inertia(R, com, inertia, i)
@@ -127,8 +131,9 @@ def composite_mass_matrix_s(mass, com, inertia, parent, kind, ucol, R, r, S, IC,
         if p >= 0:
             _add_about_parent(IC, i, p, r[i, 0] - r[p, 0], r[i, 1] - r[p, 1],
                               r[i, 2] - r[p, 2])
-    for k in range(M.shape[0]):          # speeds on different branches do not couple
-        for j in range(M.shape[1]):
+    nu = M.shape[0]
+    for k in range(nu):                  # speeds on different branches do not couple
+        for j in range(k + 1):
             M[k, j] = 0.0
     for i in range(n):
         col0 = ucol[i]
@@ -137,6 +142,13 @@ def composite_mass_matrix_s(mass, com, inertia, parent, kind, ucol, R, r, S, IC,
         m, hx, hy, hz = IC[i, 0, 0], IC[i, 0, 1], IC[i, 0, 2], IC[i, 0, 3]
         ixx, ixy, ixz, iyy, iyz, izz = (IC[i, 1, 0], IC[i, 1, 1], IC[i, 1, 2], IC[i, 1, 3],
                                         IC[i, 1, 4], IC[i, 1, 5])
+        if kind[i] == REVOLUTE:              # s = (a, 0): IC s = (I a, -h x a)
+            a0, a1, a2 = S[i, 0, 0], S[i, 1, 0], S[i, 2, 0]
+            _ancestor_rows(parent, kind, ucol, r, S, M, i, col0, hz * a1 - hy * a2,
+                           hx * a2 - hz * a0, hy * a0 - hx * a1,
+                           ixx * a0 + ixy * a1 + ixz * a2, ixy * a0 + iyy * a1 + iyz * a2,
+                           ixz * a0 + iyz * a1 + izz * a2)
+            continue
         for j in range(NU[kind[i]]):
             a0, a1, a2, l0, l1, l2 = (S[i, 0, j], S[i, 1, j], S[i, 2, j], S[i, 3, j],
                                       S[i, 4, j], S[i, 5, j])
@@ -147,6 +159,9 @@ def composite_mass_matrix_s(mass, com, inertia, parent, kind, ucol, R, r, S, IC,
                            ixx * a0 + ixy * a1 + ixz * a2 + hy * l2 - hz * l1,
                            ixy * a0 + iyy * a1 + iyz * a2 + hz * l0 - hx * l2,
                            ixz * a0 + iyz * a1 + izz * a2 + hx * l1 - hy * l0)
+    for k in range(nu):                  # the lower triangle mirrored: M exactly symmetric
+        for j in range(k):
+            M[j, k] = M[k, j]
 
 
 @internal(**FUSED)
@@ -242,8 +257,7 @@ def mass_matrix_packed(fb, ib, forces, q, M):
            alpha, a, S, scratch, 0)
     composite_mass_matrix_s(mass, com, inertia, parent, kind, ucol, R, r, S, art[2], M,
                             scratch)
-    for k in range(nu):
-        for j in range(nu):
-            if not np.isfinite(M[k, j]):
-                return -2
+    for k in range(nu):              # the diagonal suffices (composite_mass_matrix_s)
+        if not np.isfinite(M[k, k]):
+            return -2
     return -1

@@ -109,7 +109,7 @@ def _general(i, kd, seq, axis, qfull, ufull, udfull, k0, j0, J, rates, S, work):
             mv(J, v0, v1, v2), mv(J, dv0, dv1, dv2))
 
 
-@internal(**FUSED)
+@internal(constants=True, **FUSED)   # rates 0 (the mass matrix): no velocity terms
 def motion(parent, kind, axis, seq, pos, C, qoff, uoff, qfull, ufull, udfull, R, r, w, v,
            alpha, a, S, work, rates):
     """Every frame's ``R``, ``r`` and its joint's columns of ``S`` (world axes, parents
