@@ -13,6 +13,7 @@ from ..kernels import dynamics as kd
 from ..kernels import inverse as ki
 from .inputs import plain as _plain
 from .inputs import F64, ND, STRIDES
+from .inputs import empty as _empty
 from .inputs import freeze as _freeze
 from ..kernels import packed as kp
 
@@ -32,11 +33,11 @@ def mass_matrix(model, q, t=0.0):
     """The Jourdain mass matrix ``M(q)`` (nu x nu, symmetric), by composite rigid bodies
     in one compiled call (``kernels.inverse``: each joint's motion subspace, no full
     Jacobians, O(n depth)) on the merged tree (``compiled.merging``)."""
-    call = model._fast_calls.get("mass matrix")
+    call = model._fast_mass_matrix
     if call is not None and type(q) is ND and q.dtype is F64 and q.strides == STRIDES:
         # an array of the compiled type (inputs.fits): its entry, no dispatch (freeze)
         kernel, fb, ib, forces, shape = call
-        M = np.empty(shape)
+        M = _empty(shape)
         try:
             if kernel(fb, ib, forces, q, M) == -1:
                 return M

@@ -13,6 +13,7 @@ from ..kernels import inverse as ki
 from .inputs import plain as _plain
 from .forward_dynamics import ARTICULATED_FROM, METHODS
 from .inputs import F64, ND, STRIDES
+from .inputs import empty as _empty
 from .inputs import freeze as _freeze
 from .loop_newton_euler import loop_newton_euler_reactions
 from .newton_euler import tree_order
@@ -103,13 +104,13 @@ def effort_array(model, q, u, u_dot, t=0.0):
     efforts without its dictionaries, by the recursive Newton-Euler algorithm in one
     compiled call on the merged tree (O(n), ``compiled.merging``; a closed mechanism by
     ``M u' - f`` of its tree)."""
-    call = model._fast_calls.get("efforts")
+    call = model._fast_efforts
     if (call is not None and type(q) is ND and type(u) is ND and type(u_dot) is ND
             and q.dtype is F64 and u.dtype is F64 and u_dot.dtype is F64
             and q.strides == STRIDES and u.strides == STRIDES and u_dot.strides == STRIDES):
         # arrays of the compiled type (inputs.fits): its entry, no dispatch (freeze)
         kernel, fb, ib, forces, nu = call
-        tau = np.empty(nu)
+        tau = _empty(nu)
         try:
             if kernel(fb, ib, forces, q, u, u_dot, tau) == -1:
                 return tau

@@ -84,6 +84,7 @@ class Model:
         #: dispatch), with their packed arguments, by method (``kernels.entries.direct``,
         #: ``algorithms.inputs.freeze``): filled on first use
         self._fast_calls = {}
+        self._fast_mass_matrix = self._fast_efforts = None   # the hottest two, as attributes
         #: controllers in Python and PID integral terms, updated at their sampling
         #: instants between compiled stretches (``integrate.sampled``)
         self._controllers = tuple(controllers)

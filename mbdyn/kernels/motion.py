@@ -69,6 +69,34 @@ def rodrigues(x, y, z, angle):
             z * x * k - y * s, z * y * k + x * s, c + z * z * k)
 
 
+@internal(forceinline=True, **FUSED)
+def turned(J, x, y, z, angle):
+    """``J Rot(a, angle)`` and the axis ``J a`` in world axes, for the unit axis ``a = (x, y,
+    z)`` in the joint frame ``J`` (9-tuple).  An axis along ``x``, ``y`` or ``z`` (as URDF
+    files mostly give them) turns two columns of ``J``: a third of the products of
+    ``mm(J, rodrigues(...))``, whose exact zeros they leave out."""
+    c, s = math.cos(angle), math.sin(angle)
+    if x == 0.0 and y == 0.0 and abs(z) == 1.0:
+        s *= z
+        return ((c * J[0] + s * J[1], c * J[1] - s * J[0], J[2],
+                 c * J[3] + s * J[4], c * J[4] - s * J[3], J[5],
+                 c * J[6] + s * J[7], c * J[7] - s * J[6], J[8]),
+                (z * J[2], z * J[5], z * J[8]))
+    if x == 0.0 and z == 0.0 and abs(y) == 1.0:
+        s *= y
+        return ((c * J[0] - s * J[2], J[1], c * J[2] + s * J[0],
+                 c * J[3] - s * J[5], J[4], c * J[5] + s * J[3],
+                 c * J[6] - s * J[8], J[7], c * J[8] + s * J[6]),
+                (y * J[1], y * J[4], y * J[7]))
+    if y == 0.0 and z == 0.0 and abs(x) == 1.0:
+        s *= x
+        return ((J[0], c * J[1] + s * J[2], c * J[2] - s * J[1],
+                 J[3], c * J[4] + s * J[5], c * J[5] - s * J[4],
+                 J[6], c * J[7] + s * J[8], c * J[8] - s * J[7]),
+                (x * J[0], x * J[3], x * J[6]))
+    return mm(J, rodrigues(x, y, z, angle)), mv(J, x, y, z)
+
+
 @internal(**FUSED)
 def _general(i, kd, seq, axis, qfull, ufull, udfull, k0, j0, J, rates, S, work):
     """A joint of any kind by ``joints.joint_motion``: ``Ri`` (9-tuple), the origin's
@@ -130,16 +158,16 @@ def motion(parent, kind, axis, seq, pos, C, qoff, uoff, qfull, ufull, udfull, R,
         wrel = dwrel = vrel = dvrel = zero      # relative motion, world axes
         if kd == REVOLUTE or kd == PRISMATIC:
             x, y, z = axis[i, 0], axis[i, 1], axis[i, 2]
-            e = mv(J, x, y, z)                   # the joint's axis
             uc = ufull[j0] if rates else 0.0
             udc = udfull[j0] if rates else 0.0
             if kd == REVOLUTE:
-                Ri = mm(J, rodrigues(x, y, z, qfull[k0]))
+                Ri, e = turned(J, x, y, z, qfull[k0])
                 S[i, 0, 0], S[i, 1, 0], S[i, 2, 0] = e
                 S[i, 3, 0] = S[i, 4, 0] = S[i, 5, 0] = 0.0
                 wrel = (e[0] * uc, e[1] * uc, e[2] * uc)
                 dwrel = (e[0] * udc, e[1] * udc, e[2] * udc)
             else:
+                e = mv(J, x, y, z)               # the joint's axis
                 Ri, qc = J, qfull[k0]
                 rho = (rho[0] + e[0] * qc, rho[1] + e[1] * qc, rho[2] + e[2] * qc)
                 S[i, 0, 0] = S[i, 1, 0] = S[i, 2, 0] = 0.0
