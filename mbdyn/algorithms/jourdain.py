@@ -108,10 +108,11 @@ def jourdain_packed(model, q, u, t):
     return q, u
 
 
-#: up to this many speeds the check at rest factors ``M`` (microseconds: the kernels every
-#: run compiles for its conditioning report) even where runs take the articulated
-#: route, whose packed entry point would otherwise be compiled for the check alone
-CHECK_BY_CHOLESKY = 60
+#: up to this many speeds (robots, humanoids) the check at rest factors ``M`` by the
+#: kernels every run compiles for its conditioning report, even where runs take the
+#: articulated route, whose packed entry point would otherwise be compiled for the check
+#: alone (a second of a first run); above it, compiling allocates no full Jacobians
+CHECK_BY_CHOLESKY = 40
 
 
 def check_at_rest(model, q, t=0.0):
