@@ -11,6 +11,8 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 from mbdyn.cli import compiling, main
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -46,16 +48,54 @@ def test_the_readme_command_on_a_fresh_cache_says_so_within_a_second(tmp_path):
     assert elapsed < 1.0, elapsed
 
 
-def test_no_notice_when_the_kernels_are_cached(tmp_path):
+@pytest.mark.parametrize("model, name", [
+    (["models/top.toml", "--case", "a"], "heavy top"),
+    (["models/double_pendulum.toml", "--integrator", "DOP853"], "double pendulum"),
+    (["models/four_bar.toml"], "four-bar linkage")])
+def test_no_notice_when_the_kernels_are_cached(tmp_path, model, name):
     """Once compiled (the first run here, if the cache is cold), the same command says
-    nothing about compiling; ``--json`` keeps stdout one JSON object either way."""
-    argv = [sys.executable, "-m", "mbdyn", "run", "models/top.toml", "--case", "a",
-            "--t-end", "0.05", "--json"]
+    nothing about compiling -- with the listing's scheme, an adaptive one, a closed loop;
+    ``--json`` keeps stdout one JSON object either way."""
+    argv = [sys.executable, "-m", "mbdyn", "run", *model, "--t-end", "0.05", "--json"]
     for attempt in range(2):
         done = subprocess.run(argv, cwd=ROOT, capture_output=True, text=True, env=_env())
         assert done.returncode == 0, done.stderr
-        assert json.loads(done.stdout)["model"] == "heavy top"
+        assert json.loads(done.stdout)["model"] == name
     assert "compil" not in done.stderr, done.stderr
+
+
+def test_the_estimate_counts_what_the_model_file_shows(tmp_path, monkeypatch):
+    """On an empty cache, a closed loop's run (a joint with ``cut = true``, here in a
+    case's joints only) and a model's force elements add their kernels' seconds to the
+    notice's estimate; a URDF file (not TOML) counts the core alone."""
+    text = ('[[bodies]]\nname = "b"\nmass = 1\n[[joints]]\nname = "j"\nkind = "revolute"\n'
+            'parent = "ground"\nchild = "b"\n[cases.x]\n[[cases.x.joints]]\nname = "c"\n'
+            'cut = true\n')
+    closed = tmp_path / "closed.toml"
+    closed.write_text(text)
+    forces = tmp_path / "forces.toml"
+    forces.write_text(text.replace("cut = true", "cut = false") + '[[forces]]\nname = "s"\n')
+    data = compiling._read_toml(str(closed))
+    assert compiling.features_of(data, ["--case", "x"]) == {"closed loop"}
+    assert compiling.features_of(data) == set()         # not in the case run
+    assert compiling.features_of(compiling._read_toml(str(forces))) == {"force elements"}
+    top = compiling._read_toml(str(ROOT / "models" / "top.toml"))
+    assert compiling.features_of(top, ["--case", "floor"]) == {"force elements"}
+    assert compiling.features_of(top, ["--case", "a"]) == set()
+    assert compiling.features_of(compiling._read_toml(str(ROOT / "models" / "arm6.urdf"))) \
+        == set()
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "empty"))
+    monkeypatch.setenv("MBDYN_COMPILE_NOTICE", "1")
+    seconds = compiling.SECONDS
+    base = sum(seconds[q] for _, q in compiling.CORE + compiling.INTEGRATOR_KERNELS["DOP853"])
+    for line, feature in ((["run", str(closed), "--case", "x"], "closed loop"),
+                          (["run", str(forces)], "force elements")):
+        monkeypatch.setitem(compiling._STATE, "announced", False)
+        stream = io.StringIO()
+        monkeypatch.setattr(sys, "stderr", stream)
+        assert compiling.announce_if_cold("run", line)
+        extra = sum(seconds[q] for _, q in compiling.FEATURE_KERNELS[feature])
+        assert f"~{round(base + extra + compiling.RUN_EXTRA)} s" in stream.getvalue()
 
 
 def test_the_check_finds_the_cache_where_numba_keeps_it(tmp_path):

@@ -49,7 +49,7 @@ CORE = (("evaluate", "kinematics_and_loads"), ("dynamics", "jourdain_terms"),
 COMPILING = ("run", "info", "accuracy", "equilibrium", "modes", "campbell", "plot",
              "animate", "sweep")
 SIMULATING = ("run", "accuracy", "plot", "animate", "sweep")
-_ADAPTIVE = (("adaptive", "rk_stretch"), ("packed", "state_derivative_packed"))
+_ADAPTIVE = (("adaptive", "stage"), ("adaptive", "rk_stretch"))
 #: the entry points an integrator adds (a model's first run with it)
 INTEGRATOR_KERNELS = {
     "DOP853": _ADAPTIVE, "RK45": _ADAPTIVE,
@@ -57,13 +57,24 @@ INTEGRATOR_KERNELS = {
     "euler": (("integrators", "euler_loop"),), "rk4": (("integrators", "rk4_loop"),),
     "implicit-midpoint": (("integrators", "implicit_midpoint_loop"),),
 }
+#: the entry points a model's features add, when its file shows them (``features_of``): a
+#: closed loop (a joint with ``cut = true``), force elements (``[[forces]]``)
+FEATURE_KERNELS = {
+    "closed loop": (("constrained", "constraint_state"), ("constrained", "project_state_call"),
+                    ("constrained", "constrained_accelerations_packed")),
+    "force elements": (("forces", "force_elements"),),
+}
 #: cold compile of each entry point with everything below it, CPU seconds on a 2-core
-#: machine (numba 0.68; ``mbdyn warmup``'s first routes, docs/performance.md): the
-#: estimate's source.  Others count ``OTHER`` seconds.
+#: machine (numba 0.68; ``benchmarks/compile_events.py``, docs/performance.md): the
+#: estimate's source.  Others count ``OTHER`` seconds.  A closed loop's three count its
+#: route's stages and loop too (a four-bar's first run after a tree's: 40 s); force
+#: elements count the loads' and the loop's second specialization
 SECONDS = {"kinematics_and_loads": 2.6, "jourdain_terms": 1.3, "cholesky_solve": 0.8,
-           "rk_stretch": 5.1, "state_derivative_packed": 6.9,
+           "stage": 2.7, "rk_stretch": 3.2,
            "semi_implicit_euler_loop": 3.1, "euler_loop": 3.0, "rk4_loop": 3.9,
-           "implicit_midpoint_loop": 6.6}
+           "implicit_midpoint_loop": 6.6,
+           "constraint_state": 7.0, "project_state_call": 8.0,
+           "constrained_accelerations_packed": 25.0, "force_elements": 9.0}
 OTHER = 5.0
 #: what a simulation compiles besides its integrator (the reactions' Newton-Euler system,
 #: the energies, the drives' programs)
@@ -182,27 +193,60 @@ def _option(words, flag):
     return None
 
 
-def integrator_of(model, words):
+def _read_toml(model):
+    """The model file as TOML data, or ``None`` (not TOML, unreadable, over 1 MB)."""
+    import tomllib
+    try:
+        if os.path.getsize(model) > 1_000_000:
+            return None
+        with open(model, "rb") as f:
+            return tomllib.load(f)
+    except (OSError, ValueError):
+        return None
+
+
+def integrator_of(model, words, data=None):
     """The integrator a command line runs ``model`` with, read without the model's
     loader: ``--integrator``, else the case's or the file's ``[simulation] integrator``,
     else the default DOP853; ``None`` if the file cannot be read as TOML here."""
     chosen = _option(words, "--integrator")
     if chosen:
         return chosen
-    import tomllib
+    data = _read_toml(model) if data is None else data
+    if not isinstance(data, dict):
+        return None
     try:
-        if os.path.getsize(model) > 1_000_000:
-            return None
-        with open(model, "rb") as f:
-            data = tomllib.load(f)
         case = _option(words, "--case") or data.get("model", {}).get("default_case")
         for table in (data.get("cases", {}).get(case, {}) if case else {}, data):
             value = table.get("simulation", {}).get("integrator")
             if isinstance(value, str):
                 return value
-    except (OSError, ValueError, AttributeError):
+    except AttributeError:
         return None
     return "DOP853"
+
+
+def features_of(data, words=()):
+    """The features of ``FEATURE_KERNELS`` a model file's TOML data shows, in its tables
+    or those of the case the command line runs (``--case``, else the file's default): a
+    joint with ``cut = true`` (a closed loop), a ``[[forces]]`` entry."""
+    found = set()
+    if not isinstance(data, dict):
+        return found
+    model, cases = data.get("model", {}), data.get("cases", {})
+    case = _option(words, "--case") or (model.get("default_case")
+                                        if isinstance(model, dict) else None)
+    tables = [data, cases.get(case) if isinstance(cases, dict) and case else None]
+    for table in tables:
+        if not isinstance(table, dict):
+            continue
+        joints = table.get("joints", [])
+        if isinstance(joints, list) and any(isinstance(j, dict) and j.get("cut") is True
+                                            for j in joints):
+            found.add("closed loop")
+        if table.get("forces"):
+            found.add("force elements")
+    return found
 
 
 def announce_if_cold(command, argv):
@@ -219,8 +263,11 @@ def announce_if_cold(command, argv):
             os.path.isfile(rest[0]):
         return False
     entries = CORE
+    data = _read_toml(rest[0])
     if command in SIMULATING:
-        entries += INTEGRATOR_KERNELS.get(integrator_of(rest[0], rest), ())
+        entries += INTEGRATOR_KERNELS.get(integrator_of(rest[0], rest, data), ())
+        for feature in sorted(features_of(data, rest)):
+            entries += FEATURE_KERNELS[feature]
     cold = missing(entries)
     if not cold:
         return False
