@@ -39,7 +39,7 @@ ROWS = np.array((3, 1, 1, 1, 1), np.int64)
 DATA = 14
 
 
-@njit(cache=True, inline="always")
+@internal(forceinline=True, **UNCOUNTED)
 def _point(i, s, R, r, w, v, alpha, a, rho, P, vP, aP, t1, t2):
     """World offset ``rho = R s``, position, velocity and bias acceleration of the point
     ``s`` (body axes) of frame ``i`` (-1: the ground, at rest)."""
@@ -62,7 +62,7 @@ def _point(i, s, R, r, w, v, alpha, a, rho, P, vP, aP, t1, t2):
         aP[k] = a[i, k] + t1[k] + t2[k]
 
 
-@njit(cache=True, inline="always")
+@internal(forceinline=True, **UNCOUNTED)
 def _vector(i, s, R, out):
     if i < 0:
         for k in range(3):
@@ -72,7 +72,7 @@ def _vector(i, s, R, out):
         out[k] = R[i, k, 0] * s[0] + R[i, k, 1] * s[1] + R[i, k, 2] * s[2]
 
 
-@njit(cache=True, inline="always")
+@internal(forceinline=True, **UNCOUNTED)
 def _add_point_row(G, Gabs, row, i, rho, e, sign, JT, JR):
     """``G[row] += sign * e^T J_P`` for the point at world offset ``rho`` of frame i:
     ``J_P = JT - [rho]x JR`` (a point's velocity ``v + w x rho``); ``Gabs`` sums the
@@ -89,7 +89,7 @@ def _add_point_row(G, Gabs, row, i, rho, e, sign, JT, JR):
         Gabs[row, col] += abs(term)
 
 
-@njit(cache=True, inline="always")
+@internal(forceinline=True, **UNCOUNTED)
 def _add_point_rows(G, Gabs, row, i, rho, sign, JT, JR):
     """``G[row:row + 3] += sign * J_P``: ``_add_point_row`` for the three world axes at
     once (the point's Jacobian column computed once, not once per axis)."""
@@ -108,7 +108,7 @@ def _add_point_rows(G, Gabs, row, i, rho, sign, JT, JR):
         Gabs[row + 2, col] += abs(j2)
 
 
-@njit(cache=True, inline="always")
+@internal(forceinline=True, **UNCOUNTED)
 def _add_rotation_row(G, Gabs, row, i, e, sign, JR):
     """``G[row] += sign * e^T JR_i``."""
     if i < 0:
