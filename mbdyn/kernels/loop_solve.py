@@ -58,7 +58,7 @@ def constrained_solve(M, L, ud, G, gamma, lam, info, work):
     qr_solve(L, ud, G, gamma, lam, info, RANK_TOLERANCE, work)
 
 
-@njit(cache=True, inline="always")
+@internal(forceinline=True, **UNCOUNTED)
 def _add_correction(L, ud, Y, lam, z, m):
     """``ud += M^-1 G^T lam = L^-T (Y lam)`` over the first ``m`` columns of ``Y`` (``z``:
     nu floats of scratch)."""
@@ -71,7 +71,7 @@ def _add_correction(L, ud, Y, lam, z, m):
     add_back_solved(L, z, ud)
 
 
-@njit(cache=True, inline="always")
+@internal(forceinline=True, **UNCOUNTED)
 def _pivoted_cholesky(A, keep, perm):
     """``A`` (symmetric, positive semi-definite) factored in place by Cholesky with
     complete pivoting: at most ``keep`` pivots, none below ``PASSAGE_TOLERANCE^2`` of the
@@ -156,7 +156,7 @@ def chosen_solve(L, ud, G, gamma, lam, info, work):
     return _chosen_rows_solve(L, ud, G, gamma, lam, info, keep, Y, A, res, x, z)
 
 
-@njit(cache=True, inline="always")
+@internal(forceinline=True, **UNCOUNTED)
 def _schur_rows(L, ud, G, gamma, rows, r, Y, A, res):
     """For the rows ``rows[:r]`` (row numbers, as floats): the residual ``res = gamma -
     G ud`` at those rows, ``Y = L^-1 G_r^T`` and ``A = Y^T Y`` (both triangles), the Schur
@@ -187,7 +187,7 @@ def _schur_rows(L, ud, G, gamma, rows, r, Y, A, res):
     return first
 
 
-@njit(cache=True, inline="always")
+@internal(forceinline=True, **UNCOUNTED)
 def _chosen_rows_solve(L, ud, G, gamma, lam, info, r, Y, A, res, x, z):
     """``_pivoted_solve`` on the ``r`` rows the last projection's factorisation chose
     (``info[ROWS + 1:]``): the same ``u'`` (those rows span the others while the rank

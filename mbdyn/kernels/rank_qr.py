@@ -28,6 +28,7 @@ import numpy as np
 from numba import njit
 
 from .views import UNCOUNTED, c_view
+from .internal import internal
 
 #: the non-zero rows are solved by the normal equations (``_gram_solve``) when the last
 #: pivot of ``Y``'s pivoted factor stays above this fraction of the first (the smallest
@@ -41,7 +42,7 @@ def work_size(nu, m):
     return nu * m + m * m + 8 * m + 2 * nu
 
 
-@njit(cache=True, inline="always")
+@internal(forceinline=True, **UNCOUNTED)
 def _reflect(A, k, rows, cols, col0):
     """Householder reflector of ``A[k:rows, k]`` (kept there, the vector ``v``), applied to
     ``A[k:rows, col0:cols]``; returns ``(R_kk, beta)`` with ``H = I - beta v v^T``."""
@@ -67,7 +68,7 @@ def _reflect(A, k, rows, cols, col0):
     return alpha, beta
 
 
-@njit(cache=True, inline="always")
+@internal(forceinline=True, **UNCOUNTED)
 def _apply_reflectors(A, beta, r, x, rows):
     """``x = H_0 H_1 ... H_(r-1) x`` for the reflectors kept in ``A``'s columns."""
     for k in range(r - 1, -1, -1):
@@ -81,7 +82,7 @@ def _apply_reflectors(A, beta, r, x, rows):
             x[i] -= s * A[i, k]
 
 
-@njit(cache=True, inline="always")
+@njit(forceinline=True, **UNCOUNTED)   # the tests call it from Python too
 def pivoted_qr(A, tolerance, perm, Rd, beta):
     """Householder QR with column pivoting of ``A`` (rows x cols) in place: ``perm`` the
     column order, ``Rd`` the diagonal of ``R``, ``R``'s strict upper part in ``A``, the
@@ -111,7 +112,7 @@ def pivoted_qr(A, tolerance, perm, Rd, beta):
     return min(rows, cols), first
 
 
-@njit(cache=True, inline="always")
+@internal(forceinline=True, **UNCOUNTED)
 def residual_rows(G, gamma, ud, res, index):
     """``res = gamma - G ud``, and in ``index`` the rows of ``G`` that are not all zero
     (row numbers, as floats); returns how many.  A row of zeros (a planar mechanism's
@@ -181,7 +182,7 @@ def qr_solve(L, ud, G, gamma, lam, info, tolerance, work):
         lam[int(index[int(perm[i])])] = mu[i]
 
 
-@njit(cache=True, inline="always")
+@internal(forceinline=True, **UNCOUNTED)
 def add_back_solved(L, z, ud):
     """``ud += L^-T z`` (``z`` overwritten by ``L^-T z``): a correction ``z = Y lam`` of
     the accelerations, ``M^-1 G^T lam`` with ``M = L L^T``."""
@@ -195,7 +196,7 @@ def add_back_solved(L, z, ud):
         ud[i] += z[i]
 
 
-@njit(cache=True, inline="always")
+@internal(forceinline=True, **UNCOUNTED)
 def pivoted_back(A, perm, rank, rhs, out, x):
     """``out`` (all rows): the solution of the pivoted rows' system ``C C^T x =
     rhs[perm[:rank]]`` at those rows, zero elsewhere (``C`` in ``A``'s lower triangle;
@@ -217,7 +218,7 @@ def pivoted_back(A, perm, rank, rhs, out, x):
         out[int(perm[i])] = x[i]
 
 
-@njit(cache=True, inline="always")
+@internal(forceinline=True, **UNCOUNTED)
 def _pivoted_cholesky(B, mc, perm):
     """``B[perm][:, perm] = C C^T`` in place (``C`` in ``B``'s lower triangle), by
     Cholesky with diagonal pivoting; returns the first pivot, or 0 when a pivot falls
@@ -250,7 +251,7 @@ def _pivoted_cholesky(B, mc, perm):
     return first
 
 
-@njit(cache=True, inline="always")
+@njit(forceinline=True, **UNCOUNTED)   # the tests call it from Python too
 def _gram_solve(A, mc, res, index, L, ud, lam, info, B, perm, rows, w, z):
     """The constrained ``u'`` and the multipliers when the ``mc`` columns of ``A = Y`` (the
     rows ``index[:mc]`` of ``G``) are independent and well conditioned: ``B = A^T A``
@@ -290,7 +291,7 @@ def _gram_solve(A, mc, res, index, L, ud, lam, info, B, perm, rows, w, z):
     return True
 
 
-@njit(cache=True, inline="always")
+@internal(forceinline=True, **UNCOUNTED)
 def _min_norm_multipliers(A, Rd, r, m, w, B, Ud, beta2, mu):
     """``mu``: the minimum-norm solution of ``[R11 R12] mu = w`` (``R`` as ``pivoted_qr``
     left it); ``B`` (m x m), ``Ud``, ``beta2``: scratch."""
