@@ -82,6 +82,21 @@ def test_the_estimate_counts_what_the_model_file_shows(tmp_path, monkeypatch):
     top = compiling._read_toml(str(ROOT / "models" / "top.toml"))
     assert compiling.features_of(top, ["--case", "floor"]) == {"force elements"}
     assert compiling.features_of(top, ["--case", "a"]) == set()
+    # what the case run makes, as the loader merges it: a case's list replaces the file's,
+    # its table by name amends it; switched effects may leave the force elements out
+    both = {"joints": [{"name": "j", "cut": True}], "forces": [{"name": "s"}],
+            "cases": {"none": {"joints": [{"name": "j"}], "forces": []},
+                      "cut": {"joints": {"k": {"cut": True}}}}}
+    assert compiling.features_of(both) == {"closed loop", "force elements"}
+    assert compiling.features_of(both, ["--case", "none"]) == set()
+    assert compiling.features_of(dict(both, joints=[], forces=[]), ["--case", "cut"]) == \
+        {"closed loop"}
+    assert compiling.features_of(both, ["--effects=-s"]) == {"closed loop"}
+    assert compiling.features_of(dict(both, effects={"s": False})) == {"closed loop"}
+    for odd in ({"model": {"default_case": ["a"]}}, {"model": [], "cases": []},
+                {"joints": "x", "forces": 3, "cases": {"a": 1}}):
+        assert compiling.features_of(odd, ["--case", "a"]) <= {"force elements"}
+        compiling.integrator_of("", [], odd)      # the loader refuses it, with a message
     assert compiling.features_of(compiling._read_toml(str(ROOT / "models" / "arm6.urdf"))) \
         == set()
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "empty"))

@@ -60,21 +60,21 @@ INTEGRATOR_KERNELS = {
 #: the entry points a model's features add, when its file shows them (``features_of``): a
 #: closed loop (a joint with ``cut = true``), force elements (``[[forces]]``)
 FEATURE_KERNELS = {
-    "closed loop": (("constrained", "constraint_state"), ("constrained", "project_state_call"),
-                    ("constrained", "constrained_accelerations_packed")),
+    "closed loop": (("constrained", "constraint_state"), ("constrained", "project_state_call")),
     "force elements": (("forces", "force_elements"),),
 }
 #: cold compile of each entry point with everything below it, CPU seconds on a 2-core
 #: machine (numba 0.68; ``benchmarks/compile_events.py``, docs/performance.md): the
-#: estimate's source.  Others count ``OTHER`` seconds.  A closed loop's three count its
-#: route's stages and loop too (a four-bar's first run after a tree's: 40 s); force
-#: elements count the loads' and the loop's second specialization
+#: estimate's source.  Others count ``OTHER`` seconds.  A closed loop's two count its
+#: route's stages and loop, and the multipliers' entry of its reactions, too (a four-bar's
+#: first run after a tree's: 40 s; only kernels every closed loop's run compiles are
+#: looked for, or a warm run would be told it compiles); force elements count the loads'
+#: and the loop's second specialization
 SECONDS = {"kinematics_and_loads": 2.6, "jourdain_terms": 1.3, "cholesky_solve": 0.8,
            "stage": 2.7, "rk_stretch": 3.2,
            "semi_implicit_euler_loop": 3.1, "euler_loop": 3.0, "rk4_loop": 3.9,
            "implicit_midpoint_loop": 6.6,
-           "constraint_state": 7.0, "project_state_call": 8.0,
-           "constrained_accelerations_packed": 25.0, "force_elements": 9.0}
+           "constraint_state": 7.0, "project_state_call": 33.0, "force_elements": 9.0}
 OTHER = 5.0
 #: what a simulation compiles besides its integrator (the reactions' Newton-Euler system,
 #: the energies, the drives' programs)
@@ -205,6 +205,18 @@ def _read_toml(model):
         return None
 
 
+def _case_table(data, words):
+    """The table of the case the command line runs (``--case``, else the file's default),
+    or ``{}``: read as the loader would, without its checks (a malformed file is its to
+    refuse, with a message)."""
+    model, cases = data.get("model", {}), data.get("cases", {})
+    case = _option(words, "--case") or (model.get("default_case")
+                                        if isinstance(model, dict) else None)
+    if isinstance(case, str) and isinstance(cases, dict) and isinstance(cases.get(case), dict):
+        return cases[case]
+    return {}
+
+
 def integrator_of(model, words, data=None):
     """The integrator a command line runs ``model`` with, read without the model's
     loader: ``--integrator``, else the case's or the file's ``[simulation] integrator``,
@@ -215,37 +227,52 @@ def integrator_of(model, words, data=None):
     data = _read_toml(model) if data is None else data
     if not isinstance(data, dict):
         return None
-    try:
-        case = _option(words, "--case") or data.get("model", {}).get("default_case")
-        for table in (data.get("cases", {}).get(case, {}) if case else {}, data):
-            value = table.get("simulation", {}).get("integrator")
-            if isinstance(value, str):
-                return value
-    except AttributeError:
-        return None
+    for table in (_case_table(data, words), data):
+        simulation = table.get("simulation", {})
+        value = simulation.get("integrator") if isinstance(simulation, dict) else None
+        if isinstance(value, str):
+            return value
     return "DOP853"
 
 
+def _elements(data, case, key):
+    """The array ``key`` (joints, forces) of the model a case makes: the case's list
+    replaces the file's, its table of elements by name amends or extends it
+    (``io.cases.apply_case``)."""
+    base = data.get(key, [])
+    out = [dict(e) for e in base if isinstance(e, dict)] if isinstance(base, list) else []
+    value = case.get(key)
+    if isinstance(value, list):
+        return [e for e in value if isinstance(e, dict)]
+    if isinstance(value, dict):
+        for name, partial in value.items():
+            if not isinstance(partial, dict):
+                continue
+            for element in out:
+                if element.get("name") == name:
+                    element.update(partial)
+                    break
+            else:
+                out.append(dict(partial, name=name))
+    return out
+
+
 def features_of(data, words=()):
-    """The features of ``FEATURE_KERNELS`` a model file's TOML data shows, in its tables
-    or those of the case the command line runs (``--case``, else the file's default): a
-    joint with ``cut = true`` (a closed loop), a ``[[forces]]`` entry."""
+    """The features of ``FEATURE_KERNELS`` the model a command line runs surely has, read
+    from its file's TOML data and the case run: a joint with ``cut = true`` (a closed loop);
+    force elements, unless effects are switched (``--effects``, an ``[effects]`` table:
+    they may switch the elements off, and a kernel counted but never compiled would give
+    the notice on every run)."""
     found = set()
     if not isinstance(data, dict):
         return found
-    model, cases = data.get("model", {}), data.get("cases", {})
-    case = _option(words, "--case") or (model.get("default_case")
-                                        if isinstance(model, dict) else None)
-    tables = [data, cases.get(case) if isinstance(cases, dict) and case else None]
-    for table in tables:
-        if not isinstance(table, dict):
-            continue
-        joints = table.get("joints", [])
-        if isinstance(joints, list) and any(isinstance(j, dict) and j.get("cut") is True
-                                            for j in joints):
-            found.add("closed loop")
-        if table.get("forces"):
-            found.add("force elements")
+    case = _case_table(data, words)
+    if any(j.get("cut") is True for j in _elements(data, case, "joints")):
+        found.add("closed loop")
+    switched = (_option(words, "--effects") is not None or "effects" in data
+                or "effects" in case)
+    if _elements(data, case, "forces") and not switched:
+        found.add("force elements")
     return found
 
 
