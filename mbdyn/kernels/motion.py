@@ -14,7 +14,7 @@ same quantities in the same frames as ``walk`` (``kinematics``'s docstring), to 
 import math
 
 
-from .joints import FIXED, MAX_NU, NQ, NU, PRISMATIC, REVOLUTE, joint_motion
+from .joints import FIXED, FREE, MAX_NU, NQ, NU, PRISMATIC, REVOLUTE, joint_motion
 from .views import FUSED, c_view
 from .internal import internal
 
@@ -97,6 +97,35 @@ def turned(J, x, y, z, angle):
     return mm(J, rodrigues(x, y, z, angle)), mv(J, x, y, z)
 
 
+@internal(forceinline=True, **FUSED)
+def _free(i, qfull, ufull, udfull, k0, j0, J, rates, S):
+    """A free joint (a floating base) written out, as ``joints.joint_motion`` defines it:
+    ``q = (x, y, z, w, qx, qy, qz)``, the origin's offset ``(x, y, z)`` in the joint frame
+    ``J`` and the unit quaternion (normalised first, as ``joints.quaternion_to_matrix``);
+    the speeds: the origin's velocity along ``J``'s axes, then the angular velocity in the
+    body's axes.  Returns as ``_general``, the joint's six columns of ``S`` written."""
+    qw, qx, qy, qz = qfull[k0 + 3], qfull[k0 + 4], qfull[k0 + 5], qfull[k0 + 6]
+    n = math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+    w, x, y, z = qw / n, qx / n, qy / n, qz / n
+    Ri = mm(J, (1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y),
+                2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x),
+                2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)))
+    for c in range(3):
+        for k in range(3):
+            S[i, k, c] = 0.0
+            S[i, 3 + k, c] = J[3 * k + c]            # translation along J's axis c
+            S[i, k, 3 + c] = Ri[3 * k + c]           # rotation about the body's axis c
+            S[i, 3 + k, 3 + c] = 0.0
+    off = mv(J, qfull[k0], qfull[k0 + 1], qfull[k0 + 2])
+    zero = (0.0, 0.0, 0.0)
+    if not rates:
+        return Ri, off, zero, zero, zero, zero
+    u, ud = ufull, udfull
+    return (Ri, off, mv(Ri, u[j0 + 3], u[j0 + 4], u[j0 + 5]),
+            mv(Ri, ud[j0 + 3], ud[j0 + 4], ud[j0 + 5]), mv(J, u[j0], u[j0 + 1], u[j0 + 2]),
+            mv(J, ud[j0], ud[j0 + 1], ud[j0 + 2]))
+
+
 @internal(**FUSED)
 def _general(i, kd, seq, axis, qfull, ufull, udfull, k0, j0, J, rates, S, work):
     """A joint of any kind by ``joints.joint_motion``: ``Ri`` (9-tuple), the origin's
@@ -176,6 +205,10 @@ def motion(parent, kind, axis, seq, pos, C, qoff, uoff, qfull, ufull, udfull, R,
                 dvrel = (e[0] * udc, e[1] * udc, e[2] * udc)
         elif kd == FIXED:
             Ri = J
+        elif kd == FREE:
+            Ri, off, wrel, dwrel, vrel, dvrel = _free(i, qfull, ufull, udfull, k0, j0, J, rates,
+                                                      S)
+            rho = (rho[0] + off[0], rho[1] + off[1], rho[2] + off[2])
         else:
             Ri, off, wrel, dwrel, vrel, dvrel = _general(i, kd, seq, axis, qfull, ufull,
                                                          udfull, k0, j0, J, rates, S, work)
