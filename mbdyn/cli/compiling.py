@@ -237,8 +237,9 @@ def integrator_of(model, words, data=None):
 
 def _elements(data, case, key):
     """The array ``key`` (joints, forces) of the model a case makes: the case's list
-    replaces the file's, its table of elements by name amends or extends it
-    (``io.cases.apply_case``)."""
+    replaces the file's, its table of elements by name amends or extends it, as
+    ``io.cases.apply_case`` merges them (not called: importing ``mbdyn.io`` takes a second,
+    which the notice cannot wait, and it records where each value came from)."""
     base = data.get(key, [])
     out = [dict(e) for e in base if isinstance(e, dict)] if isinstance(base, list) else []
     value = case.get(key)

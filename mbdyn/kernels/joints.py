@@ -62,24 +62,28 @@ def rotation_about_coordinate_axis(k, angle, out):
     out[j, i] = s
 
 
-@internal(**UNCOUNTED)
-def quaternion_to_matrix(q, out):
-    """Rotation matrix of the quaternion ``q = (w, x, y, z)``, normalised first.
+@internal(forceinline=True, **UNCOUNTED)
+def quaternion_matrix(qw, qx, qy, qz):
+    """Rotation matrix of the quaternion ``(qw, qx, qy, qz)``, normalised first, as a
+    9-tuple row by row (``quaternion_to_matrix``, and the per-call kinematics' free joint,
+    ``motion._free``).
 
     Normalising here makes the dynamics independent of any drift of ``|q|`` that an
     integrator lets in; the drift itself is reported by the simulation.
     """
-    n = np.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
-    w, x, y, z = q[0] / n, q[1] / n, q[2] / n, q[3] / n
-    out[0, 0] = 1.0 - 2.0 * (y * y + z * z)
-    out[0, 1] = 2.0 * (x * y - w * z)
-    out[0, 2] = 2.0 * (x * z + w * y)
-    out[1, 0] = 2.0 * (x * y + w * z)
-    out[1, 1] = 1.0 - 2.0 * (x * x + z * z)
-    out[1, 2] = 2.0 * (y * z - w * x)
-    out[2, 0] = 2.0 * (x * z - w * y)
-    out[2, 1] = 2.0 * (y * z + w * x)
-    out[2, 2] = 1.0 - 2.0 * (x * x + y * y)
+    n = np.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+    w, x, y, z = qw / n, qx / n, qy / n, qz / n
+    return (1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y),
+            2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x),
+            2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y))
+
+
+@internal(**UNCOUNTED)
+def quaternion_to_matrix(q, out):
+    """``quaternion_matrix`` of ``q = (w, x, y, z)`` into the 3x3 array ``out``."""
+    m = quaternion_matrix(q[0], q[1], q[2], q[3])
+    for k in range(9):
+        out[k // 3, k % 3] = m[k]
 
 
 @internal(**UNCOUNTED)

@@ -14,7 +14,8 @@ same quantities in the same frames as ``walk`` (``kinematics``'s docstring), to 
 import math
 
 
-from .joints import FIXED, FREE, MAX_NU, NQ, NU, PRISMATIC, REVOLUTE, joint_motion
+from .joints import (FIXED, FREE, MAX_NU, NQ, NU, PRISMATIC, REVOLUTE, joint_motion,
+                     quaternion_matrix)
 from .views import FUSED, c_view
 from .internal import internal
 
@@ -101,15 +102,10 @@ def turned(J, x, y, z, angle):
 def _free(i, qfull, ufull, udfull, k0, j0, J, rates, S):
     """A free joint (a floating base) written out, as ``joints.joint_motion`` defines it:
     ``q = (x, y, z, w, qx, qy, qz)``, the origin's offset ``(x, y, z)`` in the joint frame
-    ``J`` and the unit quaternion (normalised first, as ``joints.quaternion_to_matrix``);
+    ``J`` and the unit quaternion (``joints.quaternion_matrix``, normalised first);
     the speeds: the origin's velocity along ``J``'s axes, then the angular velocity in the
     body's axes.  Returns as ``_general``, the joint's six columns of ``S`` written."""
-    qw, qx, qy, qz = qfull[k0 + 3], qfull[k0 + 4], qfull[k0 + 5], qfull[k0 + 6]
-    n = math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
-    w, x, y, z = qw / n, qx / n, qy / n, qz / n
-    Ri = mm(J, (1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y),
-                2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x),
-                2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)))
+    Ri = mm(J, quaternion_matrix(qfull[k0 + 3], qfull[k0 + 4], qfull[k0 + 5], qfull[k0 + 6]))
     for c in range(3):
         for k in range(3):
             S[i, k, c] = 0.0
