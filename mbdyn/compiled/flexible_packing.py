@@ -76,12 +76,12 @@ class FlexibleKernels:
                   "free_q": self.free_q, "free_u": self.free_u, "con_int": con_int,
                   "cf": cf, "G": self.G, "lw": self.lw,
                   **dict(zip(FLEX_NAMES, self.flex))}
-        fbuf, ibuf, _, forces = tree._packed
+        fbuf, ibuf = tree._packed[:2]
         #: False where the compiled route cannot take the model (contacts between shapes)
-        self.takes = forces is None or forces[1] is None
+        self.takes = tree._force_shapes is None
         #: set by ``FlexibleModel.compiled_terms`` (opt-in: its first use compiles 20-30 s)
         self.opted = False
-        self._kind = (forces is not None, len(self.flex[7]) > 0, m > 0)
+        self._kind = (tree._force_int.shape[0] > 0, len(self.flex[7]) > 0, m > 0)
         self.function = None            # compiled on first use (``ready``)
         hook = [int(tree._switches[0]), 0, fbuf.ctypes.data, fbuf.size, ibuf.ctypes.data,
                 ibuf.size, model.nq, model.nu, tree.nu]

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..kernels import evaluate as ke
+from ..kernels import force_function as kff
 from ..kernels import joints as kj
 from ..kernels import constrained as kc
 from ..kernels import packed as kp
@@ -271,13 +272,14 @@ def pack(model, loop_joints=0):
         {k: getattr(model, attr[k]) for k in kp.FAR}, merged)
     for name, view in views.items():
         setattr(model, attr[name], view)
-    # the force elements as the kernels take them (kernels.packed): None without any, so
-    # that the kernels are compiled without the force kernel; else the table and None or
-    # True for its contacts between shapes (without, no shape-contact kernel)
+    # the force elements as the kernels take them (kernels.force_function): the table and
+    # the address of the compiled function that applies it (none, without contacts between
+    # shapes, with them), an integer for every model: no kernel is compiled again for them
     model._force_shapes = (True if (model._force_int[:, 0] == CONTACT_SHAPES).any()
                            else None)
-    forces = ((model._force_int, model._force_shapes) if model._force_int.shape[0]
-              else None)
+    kind = (kff.NONE if not model._force_int.shape[0] else
+            kff.SHAPES if model._force_shapes else kff.PLAIN)
+    forces = (model._force_int, kff.address(kind))
     model._packed = (fbuf, ibuf, table, forces)
     # the per-call entries' arguments (the integer buffer stands for its table): the full
     # tree's, and the merged tree's
@@ -285,8 +287,7 @@ def pack(model, loop_joints=0):
     model._dynamics, model._dynamics_ud = model._dynamics_full, model._ud
     model._merged_frames = 0
     if merged is not None:
-        model._dynamics = (fbuf, ibuf2,
-                           None if forces is None else (views2["force_int"], forces[1]))
+        model._dynamics = (fbuf, ibuf2, (views2["force_int"], forces[1]))
         model._dynamics_ud = views2["ud"]
         model._merged_frames = model.n_frames - merged["n"]
 
@@ -312,10 +313,9 @@ def full_workspace(model):
 
 
 def argument_groups(model):
-    """The groups of arrays the kernels take together: the tree, the loads (``None``
-    for the force table of a model without force elements, so that the compiled kernels
-    are specialised without them: ``kernels/evaluate.kinematics_and_loads``), and the
-    kinematics' outputs."""
+    """The groups of arrays the kernels take together: the tree, the loads (with the
+    force elements' table and function, ``kernels.force_function``), and the kinematics'
+    outputs."""
     model._tree = (model._parent, model._kind, model._axis, model._seq, model._pos, model._C,
                    model._qoff, model._uoff, model._ucol, model._anc_ptr, model._anc_idx)
     model._loads_arrays = (model._load_body, model._load_point, model._load_force,

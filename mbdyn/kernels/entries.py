@@ -11,8 +11,8 @@ degree of freedom has no inertia, -2 for a non-finite result.
 The integer buffer ``ib`` starts with the offset table (``packed.pack``) and stands for it:
 one array less to type and unbox at every call; the force table is its view
 (``packed.force_table``), so the entries are compiled with the force kernel.  The ordinary
-``Model`` methods call the packed kernels themselves, with ``None`` for a model without
-force elements (a first call compiles less).
+``Model`` methods call the packed kernels themselves, with the force elements' table and the
+address of their compiled function (``force_function``: a first call compiles less).
 """
 from numba import njit, typeof
 

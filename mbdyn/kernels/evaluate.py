@@ -13,7 +13,8 @@ from .articulated import ARTICULATED_WORK, articulated_body
 from .articulated_reactions import joint_wrenches_tree, reaction_components
 from .dynamics import (applied_loads, cholesky_solve, jourdain_terms, jourdain_work,
                        newton_euler_system)
-from .forces import FORCE_WORK, force_elements
+from .force_function import apply_forces
+from .forces import FORCE_WORK
 from .kinematics import KINEMATICS_WORK, walk
 from .motion import MOTION_WORK, motion
 from .views import UNCOUNTED, c_view
@@ -48,11 +49,9 @@ def kinematics_and_loads(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_
                          forces, force_data, switches,
                          R, r, w, v, alpha, a, JR, JT, S, F, N, scratch):
     """Motion of every frame, then the applied loads ``F``, ``N``: gravity, point loads
-    and force elements.  ``forces`` is None for a model without force elements, else the
-    force table and whether it has contacts between shapes (``(force_int, shapes)``,
-    ``shapes`` None or True): types, not counts, so that numba prunes the calls and
-    compiles for such a model no force kernel, or no shape-contact kernel
-    (``forces.force_elements``)."""
+    and force elements.  ``forces``: the force table and the compiled function that
+    applies it (``force_function``: of one type for every model, so that this kernel is
+    compiled once whether a model has force elements or not)."""
     walk(parent, kind, axis, seq, pos, C, qoff, uoff, ucol, anc_ptr, anc_idx, qfull, ufull,
          udfull, R, r, w, v, alpha, a, JR, JT, S, scratch)
     loads_at(parent, axis, mass, com, gravity, qfull, ufull, load_body, load_point,
@@ -65,15 +64,15 @@ def loads_at(parent, axis, mass, com, gravity, qfull, ufull, load_body, load_poi
              load_force, load_moment, load_in_body, forces, force_data, R, r, w, v, F, N,
              scratch):
     """The applied loads ``F``, ``N`` of the motion in ``R .. v``: gravity, point loads and
-    the force elements (``forces``: None, or the force table and its shapes' flag, an
-    argument of its own so that numba prunes the force kernel for None)."""
+    the force elements (``forces``: the force table and the function that applies it,
+    ``force_function``; None for a caller that has no force elements)."""
     applied_loads(mass, com, gravity, R, r, load_body, load_point, load_force, load_moment,
                   load_in_body, F, N, scratch)
     if forces is not None:
-        force_int, shapes = forces
+        force_int, how = forces
         if force_int.shape[0]:
-            force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w,
-                           v, F, N, force_data[0:0], scratch, shapes)
+            apply_forces(how, force_int, force_data, parent, axis, com, qfull, ufull, R, r,
+                         w, v, F, N, force_data[0:0], scratch)
 
 
 @internal(**UNCOUNTED)

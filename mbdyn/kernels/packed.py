@@ -13,11 +13,11 @@ state (what ``Model._fill`` does in Python for the other evaluations); drives an
 given as Python functions are still written by the caller first.
 
 Every packed kernel takes, after the offset table, the model's force elements ``forces``:
-``None`` for a model without any, else ``(force_int, shapes)`` (the force table, a view of
-the integer buffer, and None or True for its contacts between shapes): types, not counts,
-so that the kernels are compiled for such a model without the force kernel or the
-shape-contact kernel (``evaluate.kinematics_and_loads``), as the compiled loops are.
-``Model._packed`` holds the four, so that a call reads ``kernel(*model._packed, q, u)``.
+``(force_int, address)``, the force table (a view of the integer buffer) and the address of
+the compiled function that applies it (``force_function``: one type for every model, so
+that no kernel is compiled again for a model with force elements); the low-level entries
+pass ``force_table`` instead.  ``Model._packed`` holds the four, so that a call reads
+``kernel(*model._packed, q, u)``.
 
 The arrays only the Jourdain and dense Newton-Euler routes read, O(n nu) and O(nu^2),
 are not in the buffers (``FAR``): allocated on the first use of such a route, they are
