@@ -38,6 +38,12 @@ class Model:
     def __init__(self, name, bodies, joints, loads, gravity, warnings=(), parameters=None,
                  gravity_symbolic=None, forces=(), effects=None, loop_joints=(),
                  controllers=()):
+        #: what it is compiled from: a pickled model is compiled again from it (__reduce__)
+        self._arguments = ((name, tuple(bodies), tuple(joints), tuple(loads), gravity),
+                           dict(warnings=tuple(warnings), parameters=parameters,
+                                gravity_symbolic=gravity_symbolic, forces=tuple(forces),
+                                effects=effects, loop_joints=tuple(loop_joints),
+                                controllers=tuple(controllers)))
         self.name = name
         self.warnings = tuple(warnings)
         self.gravity = np.array(gravity, dtype=float)
@@ -97,6 +103,18 @@ class Model:
     def __repr__(self):
         return (f"<Model {self.name!r}: {self.n_frames} frames, {len(self.joints)} joints, "
                 f"nq={self.nq}, nu={self.nu}>")
+
+    def __reduce__(self):
+        """Pickled as what it was compiled from, and compiled again when unpickled (with
+        its loops' bodies and its actuators' plant, which ``System.compile`` adds): its
+        arrays are views of two buffers whose addresses its kernels hold, with the address
+        of its force elements' compiled function, and a copy would keep none of them (an
+        unpickled copy read freed memory: the process crashed)."""
+        if type(self) is not Model:
+            raise TypeError(f"a {type(self).__name__} ({self.name!r}) cannot be pickled; "
+                            "pickle the System or the model file it was compiled from")
+        extras = {k: getattr(self, k) for k in ("loops", "_plant") if hasattr(self, k)}
+        return _compiled_again, (*self._arguments, extras)
 
     # ------------------------------------------------------------------ names and records
     def joint(self, name):
@@ -288,6 +306,14 @@ class Model:
             #                             parallel loops take no nested tuples
         return (self.nq, slots, quats, self._free_q, self._free_u, drive_q, drive_u,
                 tree, body, self._loads_arrays, ws)
+
+
+def _compiled_again(arguments, options, extras):
+    """A pickled ``Model`` (``Model.__reduce__``)."""
+    model = Model(*arguments, **options)
+    for name, value in extras.items():
+        setattr(model, name, value)
+    return model
 
 
 def _look_up(table, name, what, plural, known):
