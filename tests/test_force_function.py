@@ -1,4 +1,5 @@
-"""The force elements reach the kernels as a first-class function (``kernels.force_function``):
+"""The force elements reach the kernels through a compiled function's address
+(``kernels.force_function``):
 a model with force elements and one without pass their loads with the same numba types
 (the function's address), so
 that the kinematics, the routes, the loops and the adaptive stretches compiled for one
@@ -6,8 +7,9 @@ serve the other (before, a first model with force elements compiled them all aga
 import warnings
 from pathlib import Path
 
+import numpy as np
 import pytest
-from numba import typeof
+from numba import cfunc, njit, typeof
 
 import mbdyn as mb
 from mbdyn.kernels import force_function as kff
@@ -33,3 +35,34 @@ def test_loads_have_one_type_with_and_without_force_elements(name, kind):
     assert forced._packed[3][1] == kff.address(kind) != 0
     assert kff.NONE not in kff._MADE
 
+
+def _failing(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F, N, acc,
+             work):
+    """A force function as the module makes them: what the kernel raises becomes FAILED."""
+    try:
+        F[0, 0] = force_data[0] / force_data[1]
+    except Exception:
+        return kff.FAILED
+    return 0
+
+
+@njit
+def _loads(where, force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F, N,
+           acc, work):
+    kff.apply_forces(where, force_int, force_data, parent, axis, com, qfull, ufull, R, r, w,
+                     v, F, N, acc, work)
+    return F[0, 0]
+
+
+def test_a_force_function_that_fails_raises_in_its_caller():
+    """A C function cannot raise (numba's wrapper prints the exception and returns): the
+    caller raises ``ZeroDivisionError`` again, which the evaluations report as before."""
+    failing = cfunc(kff.SIGNATURE)(_failing)
+    arrays = (np.zeros((1, 10), np.int64), np.array([1.0, 0.0]), np.zeros(1, np.int64),
+              np.zeros((1, 3)), np.zeros((1, 3)), np.zeros(1), np.zeros(1), np.zeros((1, 3, 3)),
+              np.zeros((1, 3)), np.zeros((1, 3)), np.zeros((1, 3)), np.zeros((1, 3)),
+              np.zeros((1, 3)), np.zeros(0), np.zeros(10))
+    with pytest.raises(ZeroDivisionError, match="force element"):
+        _loads(failing.address, *arrays)
+    arrays[1][1] = 4.0                              # no division by zero: 1 / 4
+    assert _loads(failing.address, *arrays) == 0.25

@@ -39,8 +39,9 @@ class Model:
                  gravity_symbolic=None, forces=(), effects=None, loop_joints=(),
                  controllers=()):
         #: what it is compiled from: a pickled model is compiled again from it (__reduce__)
-        self._arguments = ((name, tuple(bodies), tuple(joints), tuple(loads), gravity),
-                           dict(warnings=tuple(warnings), parameters=parameters,
+        self._arguments = ((name, tuple(bodies), tuple(joints), tuple(loads),
+                            np.array(gravity, dtype=float)),
+                           dict(warnings=tuple(warnings), parameters=dict(parameters or {}),
                                 gravity_symbolic=gravity_symbolic, forces=tuple(forces),
                                 effects=effects, loop_joints=tuple(loop_joints),
                                 controllers=tuple(controllers)))

@@ -34,19 +34,31 @@ SIGNATURE = types.int64(_I2, _F1, _I1, _F2, _F2, _F1, _F1, _F3, _F2, _F2, _F2, _
 #: the kinds: no force elements (no function), the elements without contacts between
 #: shapes, and with them (``forces.force_elements``' ``shapes``: None or True)
 NONE, PLAIN, SHAPES = "none", "plain", "shapes"
+#: what a function returns when the kernel raised (``apply_forces`` raises it again)
+FAILED = 1
 
+
+# A C function cannot raise: numba's wrapper would print an exception and return, and the
+# caller go on with half the loads.  So each catches what the kernel raises (a division by
+# zero: numba's only exception there) and returns 1; ``apply_forces`` raises it again.
 
 def _plain(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F, N, acc,
            work):
-    force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F, N,
-                   acc, work, None)
+    try:
+        force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F,
+                       N, acc, work, None)
+    except Exception:
+        return FAILED
     return 0
 
 
 def _shapes(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F, N, acc,
             work):
-    force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F, N,
-                   acc, work, True)
+    try:
+        force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F,
+                       N, acc, work, True)
+    except Exception:
+        return FAILED
     return 0
 
 
@@ -100,8 +112,9 @@ def _apply_forces(how, force_int, force_data, parent, axis, com, qfull, ufull, R
     if isinstance(how, types.Integer):
         def by_address(how, force_int, force_data, parent, axis, com, qfull, ufull, R, r, w,
                        v, F, N, acc, work):
-            _call_at(how, force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v,
-                     F, N, acc, work)
+            if _call_at(how, force_int, force_data, parent, axis, com, qfull, ufull, R, r,
+                        w, v, F, N, acc, work) == FAILED:
+                raise ZeroDivisionError("division by zero in a force element")
         return by_address
 
     def in_place(how, force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F,

@@ -211,7 +211,7 @@ def jourdain_by_subspaces(tree, body, state, loads, kin, jourdain, wrench, IC, s
 def inverse_dynamics_packed(fb, ib, forces, q, u, ud, tau):
     """Scatter ``q``, ``u``, ``u'``; the kinematics with those rates and the applied loads;
     then ``recursive_newton_euler``: ``tau`` (free speeds) and the joint wrenches in the
-    ``W`` view.  ``forces``: the force table or None (``packed``).  Returns -1, or -2 when
+    ``W`` view.  ``forces``: the force elements (``packed``).  Returns -1, or -2 when
     ``tau`` holds NaN or Inf, or ``WRONG_SIZE`` for an argument of another size.  The
     integer buffer stands for the offset table (``packed.articulated_accelerations_packed``)."""
     t = ib
