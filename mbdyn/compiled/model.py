@@ -38,13 +38,7 @@ class Model:
     def __init__(self, name, bodies, joints, loads, gravity, warnings=(), parameters=None,
                  gravity_symbolic=None, forces=(), effects=None, loop_joints=(),
                  controllers=()):
-        #: what it is compiled from: a pickled model is compiled again from it (__reduce__)
-        self._arguments = ((name, tuple(bodies), tuple(joints), tuple(loads),
-                            np.array(gravity, dtype=float)),
-                           dict(warnings=tuple(warnings), parameters=dict(parameters or {}),
-                                gravity_symbolic=gravity_symbolic, forces=tuple(forces),
-                                effects=effects, loop_joints=tuple(loop_joints),
-                                controllers=tuple(controllers)))
+        self._arguments = _arguments(locals())    # what a pickled model is compiled from
         self.name = name
         self.warnings = tuple(warnings)
         self.gravity = np.array(gravity, dtype=float)
@@ -115,7 +109,7 @@ class Model:
             raise TypeError(f"a {type(self).__name__} ({self.name!r}) cannot be pickled; "
                             "pickle the System or the model file it was compiled from")
         extras = {k: getattr(self, k) for k in ("loops", "_plant") if hasattr(self, k)}
-        return _compiled_again, (*self._arguments, extras)
+        return _compiled_again, (self._arguments, extras)
 
     # ------------------------------------------------------------------ names and records
     def joint(self, name):
@@ -309,9 +303,22 @@ class Model:
                 tree, body, self._loads_arrays, ws)
 
 
-def _compiled_again(arguments, options, extras):
+def _arguments(given):
+    """What ``Model.__init__`` was given (its ``locals()`` on entry), as ``Model(**...)``
+    takes it again when a pickled model is compiled again (``Model.__reduce__``): the
+    sequences as tuples, gravity and the parameters copied (the System may change its
+    own after compiling)."""
+    args = {k: v for k, v in given.items() if k != "self"}
+    for k in ("bodies", "joints", "loads", "warnings", "forces", "loop_joints", "controllers"):
+        args[k] = tuple(args[k])
+    args["gravity"] = np.array(args["gravity"], dtype=float)
+    args["parameters"] = dict(args["parameters"] or {})
+    return args
+
+
+def _compiled_again(arguments, extras):
     """A pickled ``Model`` (``Model.__reduce__``)."""
-    model = Model(*arguments, **options)
+    model = Model(**arguments)
     for name, value in extras.items():
         setattr(model, name, value)
     return model
