@@ -19,7 +19,7 @@ Each function is made on first use, not at import (a ``cfunc`` compiles when it 
 contiguous (``C``), as every caller's are (``forces.force_elements`` cuts views of them).
 """
 from llvmlite import ir
-from numba import cfunc, types
+from numba import cfunc, njit, types
 from numba.extending import intrinsic, overload
 
 from .forces import force_elements
@@ -38,28 +38,34 @@ NONE, PLAIN, SHAPES = "none", "plain", "shapes"
 FAILED = 1
 
 
-# A C function cannot raise: numba's wrapper would print an exception and return, and the
-# caller go on with half the loads.  So each catches what the kernel raises (a division by
-# zero: numba's only exception there) and returns 1; ``apply_forces`` raises it again.
-
-def _plain(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F, N, acc,
-           work):
+@njit(**UNCOUNTED)
+def _status(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F, N, acc, work,
+            shapes):
+    """``forces.force_elements`` with what it raises (a division by zero: numba's only
+    exception there) turned into ``FAILED``: a C function cannot raise -- numba's wrapper
+    would print the exception and return, and the caller go on with half the loads --, so
+    ``apply_forces`` raises it again."""
     try:
         force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F,
-                       N, acc, work, None)
+                       N, acc, work, shapes)
     except Exception:
         return FAILED
     return 0
+
+
+# One Python function per kind: numba's cache keys a cfunc by its function, so two cfuncs of
+# one function with one signature would share a cache entry.
+
+def _plain(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F, N, acc,
+           work):
+    return _status(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F, N,
+                   acc, work, None)
 
 
 def _shapes(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F, N, acc,
             work):
-    try:
-        force_elements(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F,
-                       N, acc, work, True)
-    except Exception:
-        return FAILED
-    return 0
+    return _status(force_int, force_data, parent, axis, com, qfull, ufull, R, r, w, v, F, N,
+                   acc, work, True)
 
 
 _PYTHON = {PLAIN: _plain, SHAPES: _shapes}
@@ -102,8 +108,10 @@ def apply_forces(how, force_int, force_data, parent, axis, com, qfull, ufull, R,
     """Add the force elements' wrenches to ``F``, ``N``: ``how`` is the address of the
     loads' function (a model's ``forces``), or None or True where the caller passes the
     table itself (the low-level entries and the flexible bodies' kernels:
-    ``force_elements``' ``shapes``).  Compiled code only."""
-    raise NotImplementedError("compiled code only")
+    ``force_elements``' ``shapes``).  Compiled code only: numba compiles the
+    implementation ``_apply_forces`` chooses by ``how``'s type (the idiom of
+    ``routes.accelerations``); this body runs only if Python calls it."""
+    raise NotImplementedError("apply_forces is compiled code only")
 
 
 @overload(apply_forces, inline="always")
