@@ -10,7 +10,7 @@ import numpy as np
 
 from ..errors import NonFiniteError
 from ..kernels import dynamics as kd
-from ..kernels import inverse as ki
+from ..kernels import entries as ke
 from .inputs import plain as _plain
 from .inputs import F64, ND, STRIDES
 from .inputs import empty as _empty
@@ -36,18 +36,20 @@ def mass_matrix(model, q, t=0.0):
     call = model._fast_mass_matrix
     if call is not None and type(q) is ND and q.dtype is F64 and q.strides == STRIDES:
         # an array of the compiled type (inputs.fits): its entry, no dispatch (freeze)
-        kernel, fb, ib, forces, shape = call
+        kernel, fb, ib, shape = call
         M = _empty(shape)
         try:
-            if kernel(fb, ib, forces, q, M) == -1:
+            if kernel(fb, ib, q, M) == -1:
                 return M
         except ZeroDivisionError:
             pass                     # a failure, or another size: the checked route
     M = np.empty((model.nu, model.nu))
     status = None
+    entry = _mass_matrix_entry()
+    fb, ib = model._dynamics[:2]
     if not model._python_inputs and _plain(q, model.nq):
         try:                                 # a float64 array as it comes: no conversion
-            status = ki.mass_matrix_packed(*model._dynamics, q, M)
+            status = entry(fb, ib, q, M)
         except ZeroDivisionError:
             pass
     u = np.zeros(model.nu)
@@ -56,7 +58,7 @@ def mass_matrix(model, q, t=0.0):
         if model._python_inputs:             # the drives' coordinates at t
             model._fill_inputs(q, u, t)
         try:
-            status = ki.mass_matrix_packed(*model._dynamics, q, M)
+            status = entry(fb, ib, q, M)
         except ZeroDivisionError:
             raise model._division_by_zero(q, t) from None
     if status == -2:
@@ -64,9 +66,14 @@ def mass_matrix(model, q, t=0.0):
         raise NonFiniteError(f"model {model.name!r}, t={t:.6g}: the mass matrix came out "
                              "non-finite (check masses, inertias and drives)")
     if not model._python_inputs:
-        _freeze(model, "mass matrix", ki.mass_matrix_packed, model._dynamics, (q, M),
-                M.shape)
+        _freeze(model, "mass matrix", entry, (fb, ib), (q, M), M.shape)
     return M
+
+
+def _mass_matrix_entry():
+    """The mass matrix's entry compiled for its one signature (``kernels.entries``):
+    ``(fb, ib, q, M)``, the low-level call's too, so the two compile it once."""
+    return ke.entry(ke.mass_matrix, ke.MASS_MATRIX_SIGNATURE)
 
 
 def mass_matrix_by(model, q, t, terms):
