@@ -29,7 +29,7 @@ from numba import njit
 
 from .joints import REVOLUTE
 from .linalg3 import cross_to
-from .views import CACHED, UNCOUNTED, c_view
+from .views import UNCOUNTED, c_view
 from .internal import internal
 
 POINT, PERP, SLIDE, DIST, COUPLE = 0, 1, 2, 3, 4
@@ -294,85 +294,94 @@ def _constraint_rows(con_int, con_data, ucol, qoff, uoff, qfull, ufull, udfull,
     _clean(G, Gabs)
 
 
-@njit(cache=True, inline="always")
-def _apply(ic, ip, P, f, mo, R, r, com, F, N, t1, lever):
-    """Force ``f`` at the world point ``P`` and moment ``mo`` on frame ``ic``, the opposite
-    on frame ``ip`` (-1: the ground), reduced to their centres of mass."""
-    for i, sign in ((ic, 1.0), (ip, -1.0)):
-        if i < 0:
-            continue
-        for k in range(3):
-            t1[k] = com[i, 0] * R[i, k, 0] + com[i, 1] * R[i, k, 1] + com[i, 2] * R[i, k, 2]
-            lever[k] = P[k] - r[i, k] - t1[k]          # centre of mass -> P
-        cross_to(lever, f, t1)
-        for k in range(3):
-            F[i, k] += sign * f[k]
-            N[i, k] += sign * (mo[k] + t1[k])
+@internal(forceinline=True, **UNCOUNTED)
+def _world(i, A, m, o, R):
+    """The vector ``A[m, o:o + 3]``, in frame ``i``'s body axes, in world components
+    (``R_i`` times it; itself for the ground, ``i`` -1), as a 3-tuple (registers)."""
+    s0, s1, s2 = A[m, o], A[m, o + 1], A[m, o + 2]
+    if i < 0:
+        return (s0, s1, s2)
+    return (R[i, 0, 0] * s0 + R[i, 0, 1] * s1 + R[i, 0, 2] * s2,
+            R[i, 1, 0] * s0 + R[i, 1, 1] * s1 + R[i, 1, 2] * s2,
+            R[i, 2, 0] * s0 + R[i, 2, 1] * s1 + R[i, 2, 2] * s2)
 
 
-@njit(**CACHED)
+@internal(forceinline=True, **UNCOUNTED)
+def _cross(a, b):
+    """``a x b`` of 3-tuples (any frame, both in the same), without ``motion.cross``'s fused
+    multiply-adds: the wrenches keep the rounding of the products written out."""
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+@internal(forceinline=True, **UNCOUNTED)
+def _apply(i, sign, P, f, mo, R, r, com, F, N):
+    """``sign`` times the force ``f`` at the world point ``P`` and the moment ``mo`` (world
+    3-tuples), reduced to frame ``i``'s centre of mass and added to its loads ``F[i]``,
+    ``N[i]`` (world); nothing for the ground (``i`` -1)."""
+    if i < 0:
+        return
+    c0, c1, c2 = com[i, 0], com[i, 1], com[i, 2]
+    t = _cross((P[0] - r[i, 0] - (c0 * R[i, 0, 0] + c1 * R[i, 0, 1] + c2 * R[i, 0, 2]),
+                P[1] - r[i, 1] - (c0 * R[i, 1, 0] + c1 * R[i, 1, 1] + c2 * R[i, 1, 2]),
+                P[2] - r[i, 2] - (c0 * R[i, 2, 0] + c1 * R[i, 2, 1] + c2 * R[i, 2, 2])), f)
+    F[i, 0] += sign * f[0]                              # t: (centre of mass -> P) x f
+    F[i, 1] += sign * f[1]
+    F[i, 2] += sign * f[2]
+    N[i, 0] += sign * (mo[0] + t[0])
+    N[i, 1] += sign * (mo[1] + t[1])
+    N[i, 2] += sign * (mo[2] + t[2])
+
+
+@njit(**UNCOUNTED)
 def constraint_wrenches(con_int, con_data, parent, kind_of, axis, R, r, lam, F, N, com, out):
     """The loads the multipliers ``lam`` stand for: each primitive's force and moment on
     its child (at the child's point) and the opposite on its parent, added to the
     applied loads ``F``, ``N`` at the centres of mass (world).  ``out[m]``: the force and
-    moment on the child of primitive ``m`` at its child point (6), for the reactions.
+    moment on the child of primitive ``m`` at its child point (6, world), for the reactions.
     A ``COUPLE`` row's multiplier is a torque (force) along the follower joint's axis
     between its parent and child, and ``-ratio`` times it along the leader's -- the
-    gear mesh's efforts (``parent``, ``kind_of``, ``axis``: the tree's joints)."""
+    gear mesh's efforts (``parent``, ``kind_of``, ``axis``: the tree's joints; ``out[m]``
+    zero).  The 3-vectors are tuples (registers), not arrays: no allocation to compile."""
     row = 0
-    rho, P, f, mo, t1, lever = (np.empty(3), np.empty(3), np.empty(3), np.empty(3),
-                                np.empty(3), np.empty(3))
-    va, vb, d, Pp = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
+    zero = (0.0, 0.0, 0.0)
     for m in range(con_int.shape[0]):
         kind, ip, ic = con_int[m, 0], con_int[m, 1], con_int[m, 2]
-        for k in range(6):
-            out[m, k] = 0.0
+        lr = lam[row]
         if kind == COUPLE:
-            for j, scale in ((con_int[m, 3], 1.0), (con_int[m, 4], -con_data[m, 12])):
-                _vector(j, axis[j], R, va)                 # the joint's axis, world
-                for k in range(3):
-                    P[k] = r[j, k]
-                    f[k] = 0.0
-                    mo[k] = 0.0
-                    if kind_of[j] == REVOLUTE:
-                        mo[k] = scale * lam[row] * va[k]
-                    else:
-                        f[k] = scale * lam[row] * va[k]
-                _apply(j, parent[j], P, f, mo, R, r, com, F, N, t1, lever)
+            for k in range(6):
+                out[m, k] = 0.0
+            for side in range(2):
+                j = con_int[m, 3 + side]
+                e = (1.0 if side == 0 else -con_data[m, 12]) * lr
+                va = _world(j, axis, j, 0, R)           # the joint's axis, world
+                f, mo = zero, (e * va[0], e * va[1], e * va[2])
+                if kind_of[j] != REVOLUTE:
+                    f, mo = mo, zero
+                P = (r[j, 0], r[j, 1], r[j, 2])
+                _apply(j, 1.0, P, f, mo, R, r, com, F, N)
+                _apply(parent[j], -1.0, P, f, mo, R, r, com, F, N)
             row += 1
             continue
-        sp, sc = con_data[m, 0:3], con_data[m, 3:6]
-        for k in range(3):
-            f[k] = 0.0
-            mo[k] = 0.0
-        _vector(ic, sc, R, rho)
-        for k in range(3):
-            P[k] = (r[ic, k] if ic >= 0 else 0.0) + rho[k]
-        _vector(ip, sp, R, t1)
-        for k in range(3):
-            Pp[k] = (r[ip, k] if ip >= 0 else 0.0) + t1[k]
-            d[k] = P[k] - Pp[k]
+        x = _world(ic, con_data, m, 3, R)              # the child's point, world
+        P = ((r[ic, 0] if ic >= 0 else 0.0) + x[0], (r[ic, 1] if ic >= 0 else 0.0) + x[1],
+             (r[ic, 2] if ic >= 0 else 0.0) + x[2])
+        f, mo = zero, zero
         if kind == POINT:
-            for k in range(3):
-                f[k] = lam[row + k]
-            row += 3
+            f = (lr, lam[row + 1], lam[row + 2])
+            row += 2
         elif kind == PERP:
-            _vector(ip, con_data[m, 6:9], R, va)
-            _vector(ic, con_data[m, 9:12], R, vb)
-            cross_to(vb, va, t1)                  # the moment's axis: b x a (see PERP's rows)
-            for k in range(3):
-                mo[k] = lam[row] * t1[k]
-            row += 1
+            mo = _cross(_world(ic, con_data, m, 9, R), _world(ip, con_data, m, 6, R))
+            mo = (lr * mo[0], lr * mo[1], lr * mo[2])   # about b x a (see PERP's rows)
         elif kind == SLIDE:
-            _vector(ip, con_data[m, 6:9], R, va)
-            for k in range(3):
-                f[k] = lam[row] * va[k]
-            row += 1
-        else:
-            for k in range(3):
-                f[k] = lam[row] * d[k]
-            row += 1
-        for k in range(3):
-            out[m, k] = f[k]
-            out[m, 3 + k] = mo[k]
-        _apply(ic, ip, P, f, mo, R, r, com, F, N, t1, lever)   # the parent at the same P
+            f = _world(ip, con_data, m, 6, R)
+            f = (lr * f[0], lr * f[1], lr * f[2])
+        else:                                           # DIST: along P - P_p
+            x = _world(ip, con_data, m, 0, R)
+            f = (lr * (P[0] - ((r[ip, 0] if ip >= 0 else 0.0) + x[0])),
+                 lr * (P[1] - ((r[ip, 1] if ip >= 0 else 0.0) + x[1])),
+                 lr * (P[2] - ((r[ip, 2] if ip >= 0 else 0.0) + x[2])))
+        row += 1
+        out[m, 0], out[m, 1], out[m, 2] = f
+        out[m, 3], out[m, 4], out[m, 5] = mo
+        _apply(ic, 1.0, P, f, mo, R, r, com, F, N)      # the parent at the same P
+        _apply(ip, -1.0, P, f, mo, R, r, com, F, N)
