@@ -95,11 +95,10 @@ class FlexibleKernels:
             self._keep.append(arr)
             shape = tuple(arr.shape) + (0,) * (2 - ndim)
             hook += [arr.ctypes.data, *shape]
-        self.hook = np.array(hook, np.int64)
+        # last: whether routes.finish_step projects onto the loops (by this function)
+        self.hook = np.array(hook + [int(m > 0)], np.int64)
         self.ws = (self.qfull, self.ufull, self.udfull, *tree._kin_out[:8], tree._S,
                    tree._F, tree._N, tree._M, tree._f, tree._L, self.scratch)
-        if m:
-            self.ws = self.ws + tuple(con)
 
     @property
     def supported(self):

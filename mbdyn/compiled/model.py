@@ -23,7 +23,7 @@ from ..algorithms import kinematics as motion
 from ..algorithms import newton_euler as ne
 from ..algorithms import reactions as joint_reactions
 from ..errors import ModelError
-from . import layout, states
+from . import layout, route_packing, states
 from .actuator_packing import reads_time, reflect_rotors, samplers
 from .force_packing import pack_forces
 
@@ -276,31 +276,9 @@ class Model:
     def loop_arguments(self, method="jourdain"):
         """The arrays the compiled loops (``kernels.integrators.LOOPS``) take after their
         drive table: ``(nq, slots, quats, free_q, free_u, drive_q, drive_u, tree, body,
-        loads, ws)``; laid out for ``method`` ``"jourdain"`` or ``"articulated"`` (the
-        compiled loops choose their route by the workspace's layout,
-        ``routes.accelerations``)."""
-        slots = self._slots
-        quats = np.array([s.start for s in self._quaternions], np.int64)
-        drive_q = np.array([d[1] for d in self._time_inputs], np.int64)
-        drive_u = np.array([d[2] for d in self._time_inputs], np.int64)
-        body = (self._mass, self._com, self._inertia, self._has_inertia, self.gravity)
-        if method == "jourdain":
-            self._full_workspace()
-            tree, work = self._tree, (self._M, self._f, self._L)
-        elif method == "articulated":   # no ancestor lists: no full Jacobians computed
-            none = np.zeros(0, np.int64)
-            tree = self._tree[:9] + (none, none)
-            work = (self._IA, self._pA, self._cb, self._U, self._Dl, self._acc)
-        else:
-            raise ModelError(f"loop_arguments: no compiled loop for method {method!r}")
-        ws = (self._qfull, self._ufull, self._udfull, self._R, self._r, self._w, self._v,
-              self._alpha, self._a, self._JR, self._JT, self._S, self._F, self._N, *work,
-              self._scratch)
-        if self._con is not None:
-            ws += self._con             # closed loops (kernels.routes), flat: numba's
-            #                             parallel loops take no nested tuples
-        return (self.nq, slots, quats, self._free_q, self._free_u, drive_q, drive_u,
-                tree, body, self._loads_arrays, ws)
+        loads, ws)``; laid out for ``method`` ``"jourdain"`` or ``"articulated"``
+        (``compiled.route_packing``: the articulated and closed routes by address)."""
+        return route_packing.loop_arguments(self, method)
 
 
 def _arguments(given):

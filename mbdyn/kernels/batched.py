@@ -1,9 +1,9 @@
 """Batched ensembles: many members of one compiled model advanced together.
 
 Each member differs only in its initial state ``Y0[i] = [q, u]``; the model's arrays are
-shared read-only, and each member gets its own copy of the workspace (laid out for
-``M u' = f``, for the articulated-body algorithm, or with a closed mechanism's
-constraints, as the model's route is).  Each member runs the very compiled loop of a
+shared read-only, and each member gets its own copy of the workspace and, on a route
+reached by address (the articulated bodies, a closed mechanism: ``kernels.route_entry``),
+its own hook on its own copies of what that route writes.  Each member runs the very compiled loop of a
 single run with the same scheme (``kernels.integrators.LOOPS``, with the same argument
 types), so a member's final state is bit-identical to ``simulate`` with the same scheme and
 step, and a sweep compiles nothing a single run has not: no loop over all four schemes, no
@@ -17,18 +17,19 @@ import numpy as np
 from numba import config
 
 from .integrators import LOOPS, loop_scratch
+from .route_entry import HOOK, private_hook
 
-#: the workspace entries of a closed mechanism's layouts (26 arrays by the mass matrix, 29
-#: by the articulated bodies: the constraints' eight last) that members share, counted from
-#: the end: its constraints' definitions (``con_int``, ``con_data``), read only
-SHARED = (8, 7)
-
-
-def own_workspace(ws):
-    """A private copy of the workspace arrays of ``Model.loop_arguments``."""
-    closed = len(ws) in (26, 29)
-    return tuple(a if closed and len(ws) - k in SHARED else a.copy()
-                 for k, a in enumerate(ws))
+def own_workspace(ws, loads):
+    """A private copy of the workspace arrays of ``Model.loop_arguments``, and the loads
+    with, for a route reached by address (``kernels.route_entry``), a private hook on the
+    copies and on copies of the other arrays its function writes (the third item, to be
+    kept alive while the member runs)."""
+    own = tuple(a.copy() for a in ws)
+    hook = loads[7]
+    if hook.shape[0] != HOOK:     # a tree's switches (a flexible model's hook: not batched)
+        return own, loads, ()
+    hook, kept = private_hook(hook, {a.ctypes.data: c for a, c in zip(ws, own) if a.size})
+    return own, loads[:7] + (hook,), kept
 
 
 def batched_fixed_step(scheme, h, n_steps, h_last, Y0, table, table_last, nq, slots, quats,
@@ -47,17 +48,17 @@ def batched_fixed_step(scheme, h, n_steps, h_last, Y0, table, table_last, nq, sl
     no_rates, no_times = np.empty((0, ny)), np.empty(0)
 
     def member(i):
-        w = own_workspace(ws)
+        w, member_loads, _kept = own_workspace(ws, loads)
         out = np.empty((n_steps + 1, ny))
         count = np.zeros(1, np.int64)
         d, st = loop(h, Y0[i], table, nq, slots, quats, free_q, free_u, drive_q, drive_u,
-                     tree, body, loads, w, out, no_rates, count, no_times, no_events,
+                     tree, body, member_loads, w, out, no_rates, count, no_times, no_events,
                      loop_scratch(ny, scheme))
         row = out[d]
         if st == 0 and h_last > 0.0:
             last = np.empty((2, ny))
             d2, st = loop(h_last, out[n_steps], table_last, nq, slots, quats, free_q,
-                          free_u, drive_q, drive_u, tree, body, loads, w, last, no_rates,
+                          free_u, drive_q, drive_u, tree, body, member_loads, w, last, no_rates,
                           count, no_times, no_events, loop_scratch(ny, scheme))
             d += d2
             row = last[d2]

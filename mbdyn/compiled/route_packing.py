@@ -1,0 +1,63 @@
+"""The arrays the compiled loops take (``Model.loop_arguments``): the Jourdain layout of
+the workspace for every rigid model, and, for the routes reached by address (the
+articulated-body algorithm, closed mechanisms: ``kernels.route_entry``), the hook that
+stands for the loads' ``switches``.  A tree by Jourdain's ``M u' = f`` passes its own
+``switches`` and the loops inline its route, as before.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ModelError
+from ..kernels import route_entry as kre
+
+
+def loop_arguments(model, method):
+    """``(nq, slots, quats, free_q, free_u, drive_q, drive_u, tree, body, loads, ws)``
+    laid out for ``method`` (``"jourdain"`` or ``"articulated"``)."""
+    if method not in ("jourdain", "articulated"):
+        raise ModelError(f"loop_arguments: no compiled loop for method {method!r}")
+    closed = model._con is not None
+    if method == "jourdain":
+        model._full_workspace()
+    tree = model._tree
+    if method == "articulated":       # no ancestor lists: no full Jacobians computed
+        none = np.zeros(0, np.int64)
+        tree = tree[:9] + (none, none)
+    slots = model._slots
+    quats = np.array([s.start for s in model._quaternions], np.int64)
+    drive_q = np.array([d[1] for d in model._time_inputs], np.int64)
+    drive_u = np.array([d[2] for d in model._time_inputs], np.int64)
+    body = (model._mass, model._com, model._inertia, model._has_inertia, model.gravity)
+    ws = (model._qfull, model._ufull, model._udfull, model._R, model._r, model._w, model._v,
+          model._alpha, model._a, model._JR, model._JT, model._S, model._F, model._N,
+          model._M, model._f, model._L, model._scratch)
+    loads = model._loads_arrays
+    if method == "articulated" or closed:
+        route = (kre.CLOSED if method == "jourdain" else
+                 kre.ARTICULATED_CLOSED if closed else kre.ARTICULATED)
+        loads = loads[:7] + (_hook(model, route, tree, body, ws, loads, quats),)
+    return (model.nq, slots, quats, model._free_q, model._free_u, drive_q, drive_u, tree,
+            body, loads, ws)
+
+
+def _hook(model, route, tree, body, ws, loads, quats):
+    """The hook of ``route`` on the model's arrays (``kernels.route_entry``), its
+    function compiled (or loaded from numba's cache) on first use."""
+    con = model._con if model._con is not None else _no_constraints(model.nu)
+    names = [name for name, _, _, _ in kre.ARRAYS]
+    art = (model._IA, model._pA, model._cb, model._U, model._Dl, model._acc)
+    values = (*tree, *body, *ws[:17], ws[17], *art, *loads[:5], loads[5][0], *loads[6:8],
+              *con, model._slots, quats, model._free_q, model._free_u)
+    arrays = dict(zip(names, values, strict=True))
+    model._route_arrays = arrays          # the memory the hook points to, kept alive
+    h = kre.hook(arrays, int(loads[7][0]), loads[5][1], model.nq, model.nu,
+                 closed=model._con is not None)
+    h[kre.FUNCTION] = kre.entry(route).address
+    return h
+
+
+def _no_constraints(nu):
+    """A tree's stand-ins for the constraints' arrays (never read)."""
+    return (np.zeros((0, 5), np.int64), np.zeros((0, 1)), np.zeros(0), np.zeros(0),
+            np.zeros((0, nu)), np.zeros(0), np.zeros(0), np.zeros(0))
