@@ -13,9 +13,12 @@ import numpy as np
 
 from ..errors import ModelError, SimulationError
 from ..kernels import constrained as kc
+from ..kernels import flexible_entry as kfe
 from ..kernels import loop_articulated as kla
+from ..kernels import route_entry as kre
 from ..kernels.loop_solve import RANK_TOLERANCE
 from .inputs import fits, freeze, plain
+from .route_hook import loop_route, python_hook
 
 
 def groups(model):
@@ -30,9 +33,8 @@ def _evaluate(model, q, u, t):
     """The kinematics and the constraint rows at ``(q, u, t)``: ``phi, psi, G, gamma``
     left in the model's constraint workspace."""
     q, u = model._fill(q, u, t)
-    tree, _, state, _, motion, _ = groups(model)
-    try:
-        kc.constraint_state(tree, state, motion, model._con, model._scratch)
+    try:        # the route's function (algorithms.route_hook): kc.constraint_state
+        kfe.call(python_hook(model), model._ud, kre.RESIDUALS)
     except ZeroDivisionError:
         raise model._division_by_zero(q, t) from None
     return q, u
@@ -70,20 +72,6 @@ def mobility(model, q, t=0.0):
     if model._con is None:
         return model.nu
     return model.nu - model.constraint_rank(q, t)[0]
-
-
-#: a closed mechanism's forward dynamics take the articulated-body route (``"auto"``)
-#: from this many free speeds on: below it the mass matrix and its factor cost less than
-#: the unit solves (``kernels.loop_articulated``; docs/performance.md, "Closed loops")
-LOOP_ARTICULATED_FROM = 16
-
-
-def loop_route(model, method):
-    """``"jourdain"`` or ``"articulated"``: the route ``method`` stands for on a closed
-    mechanism (``"auto"``: by its number of free speeds)."""
-    if method == "auto":
-        return "articulated" if model.nu >= LOOP_ARTICULATED_FROM else "jourdain"
-    return method
 
 
 def constrained_accelerations(model, q, u, t=0.0, route="jourdain"):
@@ -140,8 +128,25 @@ def fast_call(model, q, u, route):
 
 
 def multipliers(model, q, u, t=0.0):
-    """``(u', lam)``: the accelerations and the minimum-norm multipliers."""
-    ud = constrained_accelerations(model, q, u, t)
+    """``(u', lam)``: the accelerations and the minimum-norm multipliers, by the mass
+    matrix.  Where that is the mechanism's own route (fewer than
+    ``LOOP_ARTICULATED_FROM`` free speeds), by its function (``algorithms.route_hook``):
+    the reactions and drive efforts of a run's outputs take the code the run compiled,
+    with the full Jacobians, not an entry of their own."""
+    if loop_route(model, "auto") != "jourdain":
+        ud = constrained_accelerations(model, q, u, t)
+        return ud, model._con[6].copy()
+    model._full_workspace()
+    q, u = model._fill(q, u, t)
+    ud = np.empty(model.nu)
+    try:
+        status = kfe.call(python_hook(model), ud, kre.ACCEL)
+    except ZeroDivisionError:
+        raise model._division_by_zero(q, t) from None
+    if status >= 0:
+        model._raise_singular(q, t, status)
+    if status == -2:
+        model._check_finite(q, u, t, ud, "the accelerations")
     return ud, model._con[6].copy()
 
 
@@ -152,11 +157,8 @@ def project(model, q, u, t=0.0):
     _require_loops(model)
     q, u = model._fill(q, u, t)
     y = np.concatenate([q, u])
-    tree, _, state, _, motion, _ = groups(model)
-    quats = np.array([s.start for s in model._quaternions], np.int64)
-    steps = kc.project_state_call(y, model.nq, model._slots, quats, model._free_q,
-                                  model._free_u, tree, state, motion, model._con,
-                                  model._scratch)
+    # kc.project_state_call, by the route's function (algorithms.route_hook)
+    steps = kfe.call(python_hook(model), y, kre.PROJECT)
     if steps < 0:
         raise positions_not_closed(model, t, model._con[2])
     q, u = y[:model.nq].copy(), y[model.nq:].copy()

@@ -14,7 +14,7 @@ from .inputs import F64, ND, STRIDES
 from .inputs import freeze as _freeze
 from .inputs import plain as _plain
 from .constrained import fast_call as closed_fast_call
-from .constrained import loop_route
+from .route_hook import loop_route
 from .loop_newton_euler import loop_newton_euler
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError
+from ..algorithms.route_hook import route_hook
 from ..kernels import route_entry as kre
 
 
@@ -36,28 +37,6 @@ def loop_arguments(model, method):
     if method == "articulated" or closed:
         route = (kre.CLOSED if method == "jourdain" else
                  kre.ARTICULATED_CLOSED if closed else kre.ARTICULATED)
-        loads = loads[:7] + (_hook(model, route, tree, body, ws, loads, quats),)
+        loads = loads[:7] + (route_hook(model, route, tree),)
     return (model.nq, slots, quats, model._free_q, model._free_u, drive_q, drive_u, tree,
             body, loads, ws)
-
-
-def _hook(model, route, tree, body, ws, loads, quats):
-    """The hook of ``route`` on the model's arrays (``kernels.route_entry``), its
-    function compiled (or loaded from numba's cache) on first use."""
-    con = model._con if model._con is not None else _no_constraints(model.nu)
-    names = [name for name, _, _, _ in kre.ARRAYS]
-    art = (model._IA, model._pA, model._cb, model._U, model._Dl, model._acc)
-    values = (*tree, *body, *ws[:17], ws[17], *art, *loads[:5], loads[5][0], *loads[6:8],
-              *con, model._slots, quats, model._free_q, model._free_u)
-    arrays = dict(zip(names, values, strict=True))
-    model._route_arrays = arrays          # the memory the hook points to, kept alive
-    h = kre.hook(arrays, int(loads[7][0]), loads[5][1], model.nq, model.nu,
-                 closed=model._con is not None)
-    h[kre.FUNCTION] = kre.entry(route).address
-    return h
-
-
-def _no_constraints(nu):
-    """A tree's stand-ins for the constraints' arrays (never read)."""
-    return (np.zeros((0, 5), np.int64), np.zeros((0, 1)), np.zeros(0), np.zeros(0),
-            np.zeros((0, nu)), np.zeros(0), np.zeros(0), np.zeros(0))
