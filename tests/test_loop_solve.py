@@ -234,7 +234,7 @@ def test_articulated_route_equals_the_mass_matrix_route(path, case):
 
 def test_runs_by_the_articulated_route():
     """Compiled runs take the articulated-body route (``"auto"`` from 16 free speeds,
-    ``kernels.routes``' 29-array layout): a 20-link closed chain over 0.3 s by DOP853
+    ``kernels.route_entry``'s function by address): a 20-link closed chain over 0.3 s by DOP853
     follows the mass-matrix route's motion and stays on its constraints; a parallelogram
     four-bar forced onto that route passes its singular configuration as the mass-matrix
     route does (named, on the parallelogram branch)."""

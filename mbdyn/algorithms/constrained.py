@@ -18,7 +18,8 @@ from ..kernels import loop_articulated as kla
 from ..kernels import route_entry as kre
 from ..kernels.loop_solve import RANK_TOLERANCE
 from .inputs import fits, freeze, plain
-from .route_hook import loop_route, python_hook
+# LOOP_ARTICULATED_FROM: documented here (docs/api.md); the route's choice lives in route_hook
+from .route_hook import LOOP_ARTICULATED_FROM, loop_route, model_quats, python_hook  # noqa: F401
 
 
 def groups(model):
@@ -33,8 +34,9 @@ def _evaluate(model, q, u, t):
     """The kinematics and the constraint rows at ``(q, u, t)``: ``phi, psi, G, gamma``
     left in the model's constraint workspace."""
     q, u = model._fill(q, u, t)
-    try:        # the route's function (algorithms.route_hook): kc.constraint_state
-        kfe.call(python_hook(model), model._ud, kre.RESIDUALS)
+    tree, _, state, _, motion, _ = groups(model)
+    try:
+        kc.constraint_state(tree, state, motion, model._con, model._scratch)
     except ZeroDivisionError:
         raise model._division_by_zero(q, t) from None
     return q, u
@@ -157,8 +159,11 @@ def project(model, q, u, t=0.0):
     _require_loops(model)
     q, u = model._fill(q, u, t)
     y = np.concatenate([q, u])
-    # kc.project_state_call, by the route's function (algorithms.route_hook)
-    steps = kfe.call(python_hook(model), y, kre.PROJECT)
+    tree, _, state, _, motion, _ = groups(model)
+    # the entry the route's function calls, compiled once for both (the same types)
+    steps = kc.project_state_call(y, model.nq, model._slots, model_quats(model),
+                                  model._free_q, model._free_u, tree, state, motion,
+                                  model._con, model._scratch)
     if steps < 0:
         raise positions_not_closed(model, t, model._con[2])
     q, u = y[:model.nq].copy(), y[model.nq:].copy()

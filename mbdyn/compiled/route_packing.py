@@ -2,14 +2,14 @@
 the workspace for every rigid model, and, for the routes reached by address (the
 articulated-body algorithm, closed mechanisms: ``kernels.route_entry``), the hook that
 stands for the loads' ``switches``.  A tree by Jourdain's ``M u' = f`` passes its own
-``switches`` and the loops inline its route, as before.
+``switches``, and the loops call its route compiled with them, as before.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from ..errors import ModelError
-from ..algorithms.route_hook import route_hook
+from ..algorithms.route_hook import model_quats, route_hook
 from ..kernels import route_entry as kre
 
 
@@ -26,7 +26,7 @@ def loop_arguments(model, method):
         none = np.zeros(0, np.int64)
         tree = tree[:9] + (none, none)
     slots = model._slots
-    quats = np.array([s.start for s in model._quaternions], np.int64)
+    quats = model_quats(model)
     drive_q = np.array([d[1] for d in model._time_inputs], np.int64)
     drive_u = np.array([d[2] for d in model._time_inputs], np.int64)
     body = (model._mass, model._com, model._inertia, model._has_inertia, model.gravity)

@@ -301,7 +301,7 @@ def rk_stretch(kind, A, B, C, E, E3, D, t, t_end, y, f, h_abs, rtol, atol, max_s
     keep_stages = out_K.shape[0]
     check_events = events[3].shape[0] > 0
     exponent = -1.0 / (5.0 if kind == RK45 else 8.0)
-    constrained = closed(loads, ws)    # a closed mechanism (routes)
+    constrained = closed(loads)    # a closed mechanism (routes)
     accepted = 0
     while accepted < max_accept and t < t_end:
         min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)

@@ -2,8 +2,9 @@
 
 Each member differs only in its initial state ``Y0[i] = [q, u]``; the model's arrays are
 shared read-only, and each member gets its own copy of the workspace and, on a route
-reached by address (the articulated bodies, a closed mechanism: ``kernels.route_entry``),
-its own hook on its own copies of what that route writes.  Each member runs the very compiled loop of a
+reached by address (the articulated bodies, a closed mechanism:
+``kernels.route_entry``), its own hook on its own copies of what that route writes.
+Each member runs the very compiled loop of a
 single run with the same scheme (``kernels.integrators.LOOPS``, with the same argument
 types), so a member's final state is bit-identical to ``simulate`` with the same scheme and
 step, and a sweep compiles nothing a single run has not: no loop over all four schemes, no

@@ -11,13 +11,15 @@ kernels), and the loops call it through its address: a model with flexible bodie
 the Jourdain layout of a rigid model (``Model.loop_arguments``) whose ``switches`` (the
 loads' last array, ``[gyroscopic]`` for a rigid model) is the *hook*: ``[gyroscopic,
 the function's address, ...]`` followed by the addresses and shapes of every array the
-evaluation reads (``HOOK``).  ``routes.accelerations`` and ``routes.finish_step`` test
-the hook's length (one comparison) and call the address (``call_address``).
+evaluation reads (``HOOK``).  ``routes.accelerations`` tests the hook's length (one
+comparison) and calls the address (``call_address``); ``routes.finish_step`` projects
+through it when the hook's last entry says so (a model with loop joints).
 
 Modes: ``ACCEL`` (``io``: ``u'``, nu), ``TERMS`` (the model's ``M``, ``A``, ``f`` into the
 flexible arrays), ``PROJECT`` (``io``: ``y = [q, u]``, moved onto the loop constraints).
 Returns as ``kernels.flexible`` and ``kernels.flexible_loops`` do (-1 done, a singular
-column, -2 non-finite; the projection's steps, -1 or -2).
+column, -2 non-finite; the projection's steps, -1 or -2), or ``FAILED`` where a kernel
+raised (a C function cannot raise: ``call`` and the loops raise again).
 
 One function per kind: without or with the tree's force elements, loads or force
 elements at flexible bodies' points, loop joints (``entry``), each compiled on its first
@@ -29,7 +31,8 @@ from numba import cfunc, njit, types
 from .flexible import bias_step, bodies_step, element_step, kinematics_step, model_step, \
     solve_step
 from .flexible_loops import constrained_step, project_step, rows_step
-from .flexible_views import FUNCTION, HOOK, NQ, NU, SWITCH, call_address, pointer_view
+from .flexible_views import (FAILED, FUNCTION, HOOK, NQ, NU, SWITCH, call_address,
+                             pointer_view)
 from .views import CACHED, UNCOUNTED
 
 ACCEL, TERMS, PROJECT = 0, 1, 2
@@ -39,12 +42,25 @@ SIGNATURE = types.int64(types.CPointer(types.int64), types.CPointer(types.float6
 
 @njit(**CACHED)
 def call(hook, io, mode):
-    """The hook's function on ``io`` in ``mode``, from Python."""
-    return call_address(hook[FUNCTION], hook, io, mode)
+    """The hook's function on ``io`` in ``mode``, from Python (this module's functions and
+    ``route_entry``'s): its status, or ``ZeroDivisionError`` where its kernels raised."""
+    status = call_address(hook[FUNCTION], hook, io, mode)
+    if status == FAILED:
+        raise ZeroDivisionError("division by zero in a compiled evaluation")
+    return status
 
 
 @njit(inline="always", **UNCOUNTED)
 def _run(hook_ptr, io_ptr, mode, forces, elements, loops):
+    """``_evaluate`` with what its kernels raise turned into ``FAILED``."""
+    try:
+        return _evaluate(hook_ptr, io_ptr, mode, forces, elements, loops)
+    except Exception:
+        return FAILED
+
+
+@njit(inline="always", **UNCOUNTED)
+def _evaluate(hook_ptr, io_ptr, mode, forces, elements, loops):
     """The evaluation in ``mode`` (module docstring); ``forces``, ``elements``,
     ``loops``: None or True (types: the kind's function compiles only what it has)."""
     h = pointer_view(hook_ptr, HOOK)

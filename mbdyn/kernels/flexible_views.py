@@ -8,7 +8,8 @@ buffer (address, size), its integer buffer (address, size; the offset table at i
 head), the model's coordinates, speeds, the tree's speeds]``, then ``(address, rows,
 columns)`` for each array of ``ARRAYS``.  Its first entry is the tree's ``switches``
 (``kernels.packed``): a rigid model's is that one entry, so the hook's length tells the
-compiled loops a model with flexible bodies (``kernels.routes``).
+compiled loops a model with flexible bodies (``kernels.routes``); its last entry, after
+the arrays, says whether the loops project onto loop constraints after each step.
 """
 from llvmlite import ir
 from numba import njit, types
@@ -32,6 +33,10 @@ ARRAYS = (("qfull", 0, 1), ("ufull", 0, 1), ("udfull", 0, 1), ("scratch", 0, 1),
  FLAGS, MX, AX, FX, MM, AA, FF, FWORK, SLOTS, QUATS, FREE_Q, FREE_U, CON_INT, CF, GM,
  LW) = range(len(ARRAYS))
 HOOK = HEAD + 3 * len(ARRAYS)
+#: what a function reached by a hook returns when its kernels raised (a division by zero):
+#: a C function cannot raise -- numba's wrapper prints the exception and returns 0 --, so
+#: its callers (``flexible_entry.call``, ``routes``) raise ``ZeroDivisionError`` again
+FAILED = -3
 
 
 @intrinsic

@@ -9,26 +9,23 @@ A model on such a route passes the Jourdain layout of the workspace
 (``Model.loop_arguments``) with a *hook* for the loads' ``switches``: ``[gyroscopic, the
 function's address, the force function's address, nq, nu]``, then ``(address, d0, d1,
 d2)`` for every array of ``ARRAYS`` (``hook``), and last a flag, 1 when the route
-projects the state onto loop constraints after a step (``routes.finish_step``; 0 in a
+projects the state onto loop constraints after a step (``routes.finish_step``, as in a
 flexible model's hook).  ``routes.accelerations`` tests the hook's length and calls the
 address (``flexible_views.call_address``) with ``u'`` (``ACCEL``) or the state ``y =
-[q, u]`` (``PROJECT``); Python calls a closed mechanism's function for its projection and
-its constraint rows too (``algorithms.route_hook``), so that a run compiles them once.  The function builds its views of the arrays from the hook and
-calls the very kernels the inlined routes call: the same arithmetic.
+[q, u]`` (``PROJECT``); Python calls a closed mechanism's function for its multipliers
+too (``algorithms.route_hook``), so that a run's outputs compile no entry of their own.
+The function builds its views of the arrays from the hook and calls the kernels the
+loops inlined before (``docs/performance.md``, "Seventh round"): the same arithmetic.
 """
 import ctypes
 
 import numpy as np
 from numba import cfunc, njit, types
 
-from .constrained import constrained_accelerations, constraint_state, project_state_call
+from .constrained import constrained_accelerations, project_state_call
 from .evaluate import articulated_accelerations
 from .flexible_entry import ACCEL, PROJECT
-
-#: a mode of a closed mechanism's function besides ``ACCEL`` and ``PROJECT``: the
-#: kinematics and the constraint rows at the state the arrays hold (``io`` unused)
-RESIDUALS = 3
-from .flexible_views import pointer_view
+from .flexible_views import FAILED, pointer_view
 from .loop_articulated import constrained_articulated
 from .views import UNCOUNTED, far_view
 
@@ -70,7 +67,8 @@ def hook(arrays, switch, force_address, nq, nu, closed):
         a = arrays[name]
         if a.ndim != ndim or a.dtype != (np.int64 if integer else np.float64) or \
                 not a.flags.c_contiguous:
-            raise TypeError(f"route hook: array {name!r} is {a.dtype}, {a.ndim}-d")
+            raise TypeError(f"route hook: array {name!r} is {a.dtype}, {a.ndim}-d, "
+                            f"{'' if a.flags.c_contiguous else 'not '}C-contiguous")
         h[HEAD + 4 * k] = a.ctypes.data
         h[HEAD + 4 * k + 1:HEAD + 4 * k + 1 + ndim] = a.shape
     return h
@@ -150,18 +148,26 @@ def _groups(h, x):
 
 @njit(inline="always", **UNCOUNTED)
 def _run(hook_ptr, io_ptr, mode, articulated, closed):
+    """``_route`` with what its kernels raise turned into ``FAILED`` (a C function cannot
+    raise: its callers raise ``ZeroDivisionError`` again)."""
+    try:
+        return _route(hook_ptr, io_ptr, mode, articulated, closed)
+    except Exception:
+        return FAILED
+
+
+@njit(inline="always", **UNCOUNTED)
+def _route(hook_ptr, io_ptr, mode, articulated, closed):
     """The accelerations into ``io`` (``ACCEL``) or, for a closed mechanism, the
-    projection of the state ``io`` (``PROJECT``) or the constraint rows (``RESIDUALS``),
-    returning as the inlined routes do;
+    projection of the state ``io`` (``PROJECT``), returning as the kernels called do
+    (``evaluate.articulated_accelerations``, ``constrained.constrained_accelerations``,
+    ``loop_articulated.constrained_articulated``, ``constrained.project_state_call``);
     ``articulated``, ``closed``: None or True (types: each kind's function compiles only
     its own route)."""
     h = pointer_view(hook_ptr, HOOK)
     nq, nu = h[NQ], h[NU]
     x = pointer_view(io_ptr, nq + nu if mode == PROJECT else nu)
     tree, body, state, loads, motion, jourdain, art, con, scratch = _groups(h, x)
-    if closed is not None and mode == RESIDUALS:
-        constraint_state(tree, state, motion, con, scratch)
-        return -1
     if closed is not None and mode == PROJECT:
         return project_state_call(x, nq, _two(h, PROJ, h), _one(h, PROJ + 1, h),
                                   _one(h, PROJ + 2, h), _one(h, PROJ + 3, h), tree, state,
@@ -202,4 +208,4 @@ def entry(route):
     return _COMPILED[route]
 
 
-__all__ = ["ACCEL", "PROJECT", "RESIDUALS", "hook", "private_hook", "entry"]
+__all__ = ["ACCEL", "PROJECT", "FAILED", "hook", "private_hook", "entry"]

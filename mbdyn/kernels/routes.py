@@ -1,5 +1,5 @@
 """The routes the compiled integrators take (``Model.loop_arguments``): the accelerations
-by Jourdain's ``M u' = f``, inlined, or by a function reached by address -- the
+by Jourdain's ``M u' = f``, or by a C function reached by address -- the
 articulated-body algorithm, a closed mechanism (``M u' = f + G^T lam``, ``G u' =
 gamma``; ``kernels.route_entry``), flexible bodies (``kernels.flexible_entry``) -- and
 what follows each step (unit quaternions; for a closed mechanism, the projection onto its
@@ -21,7 +21,7 @@ from numba.extending import overload
 
 from .evaluate import jourdain_accelerations
 from .flexible_entry import ACCEL, PROJECT
-from .flexible_views import FUNCTION, call_address
+from .flexible_views import FAILED, FUNCTION, call_address
 from .views import UNCOUNTED
 
 
@@ -47,7 +47,10 @@ def _accelerations_route(tree, body, loads, ws, ud):
     def route(tree, body, loads, ws, ud):
         hook = loads[7]
         if hook.shape[0] > 1:          # articulated, closed or flexible: by address
-            return call_address(hook[FUNCTION], hook, ud, ACCEL)
+            status = call_address(hook[FUNCTION], hook, ud, ACCEL)
+            if status == FAILED:
+                raise ZeroDivisionError("division by zero in the accelerations")
+            return status
         (qfull, ufull, udfull, R, r, w, v, alpha, a, JR, JT, S, F, N, M, f, L,
          scratch) = ws
         return jourdain_accelerations(tree, body, (qfull, ufull, udfull), loads,
@@ -64,7 +67,7 @@ def projects(hook):
 
 
 @njit(inline="always", **UNCOUNTED)
-def closed(loads, ws):
+def closed(loads):
     """Whether the loops run a closed mechanism (``projects``)."""
     return projects(loads[7])
 
@@ -93,5 +96,8 @@ def _finish_step_route(y, drive_vals, nq, slots, quats, free_q, free_u, drive_q,
             qfull[drive_q[d]] = drive_vals[d, 0]
             ufull[drive_u[d]] = drive_vals[d, 1]
             udfull[drive_u[d]] = drive_vals[d, 2]
-        return 5 if call_address(hook[FUNCTION], hook, y, PROJECT) < 0 else 0
+        status = call_address(hook[FUNCTION], hook, y, PROJECT)
+        if status == FAILED:
+            raise ZeroDivisionError("division by zero in the projection")
+        return 5 if status < 0 else 0
     return normalize_route
