@@ -66,15 +66,17 @@ FEATURE_KERNELS = {
 #: cold compile of each entry point with everything below it, CPU seconds on a 2-core
 #: machine (numba 0.68; ``benchmarks/compile_events.py``, docs/performance.md): the
 #: estimate's source.  Others count ``OTHER`` seconds.  A closed loop's two count its
-#: route's stages and loop, and the multipliers' entry of its reactions, too (a four-bar's
-#: first run after a tree's: 40 s; only kernels every closed loop's run compiles are
-#: looked for, or a warm run would be told it compiles); force elements count their
-#: function (``kernels.force_function``: the routes and loops are the same as without)
+#: route's function too (``kernels.route_entry``: the loops and stages are the tree's, its
+#: multipliers for the reactions go through the function), a four-bar's first run after a
+#: tree's: 27 s (two thirds of the 40 s before the routes went by address); only kernels
+#: every closed loop's run compiles are looked for, or a warm run would be told it
+#: compiles; force elements count their function (``kernels.force_function``: the routes
+#: and loops are the same as without)
 SECONDS = {"kinematics_and_loads": 2.6, "jourdain_terms": 1.3, "cholesky_solve": 0.8,
            "stage": 2.7, "rk_stretch": 3.2,
            "semi_implicit_euler_loop": 3.1, "euler_loop": 3.0, "rk4_loop": 3.9,
            "implicit_midpoint_loop": 6.6,
-           "constraint_state": 7.0, "project_state_call": 33.0, "force_elements": 5.0}
+           "constraint_state": 7.0, "project_state_call": 20.0, "force_elements": 5.0}
 OTHER = 5.0
 #: what a simulation compiles besides its integrator (the reactions' Newton-Euler system,
 #: the energies, the drives' programs)
