@@ -104,10 +104,7 @@ def constrained_accelerations(model, q, u, t=0.0, route="jourdain"):
             raise model._division_by_zero(q, t) from None
     if status == kla.DEPENDENT_ROWS:             # dependent rows: decided with M
         return constrained_accelerations(model, q, u, t)
-    if status >= 0:
-        model._raise_singular(q, t, status)
-    if status == -2:
-        model._check_finite(q, u, t, model._ud, "the accelerations")
+    _check_status(model, q, u, t, status, model._ud)
     if status == -1 and not model._python_inputs:
         freeze(model, ("closed", route), kernel, packed, (q, u), model._ud)
     return model._ud.copy()
@@ -145,11 +142,18 @@ def multipliers(model, q, u, t=0.0):
         status = kfe.call(python_hook(model), ud, kre.ACCEL)
     except ZeroDivisionError:
         raise model._division_by_zero(q, t) from None
+    _check_status(model, q, u, t, status, ud)
+    return ud, model._con[6].copy()
+
+
+def _check_status(model, q, u, t, status, ud):
+    """Raise what a closed mechanism's accelerations kernel returned, if it failed: a
+    speed's column where the constrained mass matrix is singular, -2 for a non-finite
+    ``ud``; return on success (-1)."""
     if status >= 0:
         model._raise_singular(q, t, status)
     if status == -2:
         model._check_finite(q, u, t, ud, "the accelerations")
-    return ud, model._con[6].copy()
 
 
 def project(model, q, u, t=0.0):

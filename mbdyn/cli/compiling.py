@@ -21,9 +21,8 @@ start and the first compile begins only after the imports and the model's readin
   (``--integrator``, or the model file's, read with ``tomllib``).  One missing: the
   notice, with an estimate from ``SECONDS``.
 * ``Watch``, a listener on numba's ``numba:compile`` events for the rest of the command:
-  exact (numba sends the event only when it compiles, never on a cache hit), so a kernel
-  outside ``CORE`` (another integrator's loop, force elements, a closed loop) or a new
-  argument type still gets the notice, when its compile begins.
+  exact (sent on a compile, never on a cache hit; also by ``kernels.c_function``): a kernel
+  outside ``CORE`` or of a new argument type still gets the notice when its compile begins.
 
 ``MBDYN_COMPILE_NOTICE=0`` turns both off (the test suite does, except in the tests of the
 notice itself).
@@ -329,7 +328,8 @@ class Watch:
 
         class Listener(event.Listener):
             def on_start(self, ev):
-                watch._start(ev.data["dispatcher"].py_func.__qualname__)
+                made = ev.data["dispatcher"]    # c_function's: named with its module
+                watch._start(getattr(made, "shown_name", None) or made.py_func.__qualname__)
 
             def on_end(self, ev):
                 watch._end()

@@ -26,8 +26,9 @@ elements at flexible bodies' points, loop joints (``entry``), each compiled on i
 use; a model with contacts between shapes keeps the Python route.
 """
 import numpy as np
-from numba import cfunc, njit, types
+from numba import njit, types
 
+from .c_function import c_function
 from .flexible import bias_step, bodies_step, element_step, kinematics_step, model_step, \
     solve_step
 from .flexible_loops import constrained_step, project_step, rows_step
@@ -135,5 +136,5 @@ def entry(forces, elements, loops):
     (or loaded from numba's cache), kept for the process."""
     key = (bool(forces), bool(elements), bool(loops))
     if key not in _COMPILED:
-        _COMPILED[key] = cfunc(SIGNATURE, cache=True, _nrt=False)(_KINDS[key])
+        _COMPILED[key] = c_function(SIGNATURE, _KINDS[key], cache=True, _nrt=False)
     return _COMPILED[key]

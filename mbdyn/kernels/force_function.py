@@ -19,9 +19,10 @@ Each function is made on first use, not at import (a ``cfunc`` compiles when it 
 contiguous (``C``), as every caller's are (``forces.force_elements`` cuts views of them).
 """
 from llvmlite import ir
-from numba import cfunc, njit, types
+from numba import njit, types
 from numba.extending import intrinsic, overload
 
+from .c_function import c_function
 from .forces import force_elements
 from .views import UNCOUNTED
 
@@ -76,7 +77,7 @@ def function(kind):
     """The compiled force function of ``kind`` (``PLAIN`` or ``SHAPES``), made on first use
     (and kept: its address stays valid for the process)."""
     if kind not in _MADE:
-        _MADE[kind] = cfunc(SIGNATURE, **UNCOUNTED)(_PYTHON[kind])
+        _MADE[kind] = c_function(SIGNATURE, _PYTHON[kind], **UNCOUNTED)
     return _MADE[kind]
 
 

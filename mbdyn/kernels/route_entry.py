@@ -20,8 +20,9 @@ loops inlined before (``docs/performance.md``, "Seventh round"): the same arithm
 import ctypes
 
 import numpy as np
-from numba import cfunc, njit, types
+from numba import njit, types
 
+from .c_function import c_function
 from .constrained import constrained_accelerations, project_state_call
 from .evaluate import articulated_accelerations
 from .flexible_entry import ACCEL, PROJECT
@@ -204,7 +205,7 @@ def entry(route):
     """The C function of ``route`` (``ARTICULATED``, ``CLOSED``, ``ARTICULATED_CLOSED``):
     compiled on first use (or loaded from numba's cache), kept for the process."""
     if route not in _COMPILED:
-        _COMPILED[route] = cfunc(SIGNATURE, cache=True, _nrt=False)(_KINDS[route])
+        _COMPILED[route] = c_function(SIGNATURE, _KINDS[route], cache=True, _nrt=False)
     return _COMPILED[route]
 
 
