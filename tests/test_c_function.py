@@ -13,7 +13,8 @@ import textwrap
 from numba.core import event
 
 from mbdyn.cli import compiling
-from mbdyn.kernels.c_function import c_function
+from mbdyn.kernels import force_function, route_entry
+from mbdyn.kernels.c_function import c_function, shown_name
 
 
 class Events(event.Listener):
@@ -82,3 +83,13 @@ def test_a_load_from_the_cache_is_no_event(tmp_path):
                            capture_output=True, text=True, check=True).stdout.split()
             for _ in range(2)]
     assert runs == [["1", "0"], ["0", "1"]]
+
+
+def test_the_notice_estimates_each_c_function_of_the_package():
+    """A C function that compiles before any other kernel (the closed route after
+    ``mbdyn info`` of the same mechanism cached the rest) is announced with its own
+    estimate, not the default ``OTHER``."""
+    functions = (*route_entry._KINDS.values(), *force_function._PYTHON.values())
+    for function in functions:
+        assert shown_name(function) in compiling.SECONDS, shown_name(function)
+    assert shown_name(route_entry._closed) == "route_entry._closed"

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..kernels import packed as kp
-from .inputs import F64, ND, STRIDES
+from .inputs import F64, ND
 from .inputs import freeze as _freeze
 from .inputs import plain as _plain
 from .constrained import fast_call as closed_fast_call
@@ -40,7 +40,7 @@ def forward_dynamics(model, q, u, t=0.0, method="auto"):
     docs/performance.md)."""
     call = model._fast_calls.get(method)
     if (call is not None and type(q) is ND and type(u) is ND and q.dtype is F64
-            and u.dtype is F64 and q.strides == STRIDES and u.strides == STRIDES):
+            and u.dtype is F64 and q.ndim == 1 and u.ndim == 1):
         # arrays of the compiled type (inputs.fits): its entry, no dispatch (freeze)
         kernel, fb, ib, forces, ud = call
         try:

@@ -57,22 +57,22 @@ def plain(x, n):
             and x.flags.c_contiguous and x.flags.writeable)
 
 
-#: what ``fits`` compares against: the ndarray type, float64 (native byte order), the
-#: strides of a contiguous 1-d float64 array
-ND, F64, STRIDES = np.ndarray, np.dtype(np.float64), (8,)
+#: what ``fits`` compares against: the ndarray type, float64 (native byte order)
+ND, F64 = np.ndarray, np.dtype(np.float64)
 #: the fast calls' allocation, one name lookup instead of two
 empty = np.empty
 
 
 def fits(x):
     """Whether ``x`` is of the type the compiled entries were made for (``freeze``): a
-    numpy array (not a subclass) of native float64, one-dimensional and contiguous.
-    Their sizes the kernels check themselves.  Alignment is not asked (it costs as much
-    as the rest): numba's code reads a float64 with no more than 8-byte alignment
+    numpy array (not a subclass) of native float64, one-dimensional.  Their sizes and
+    strides the kernels check themselves (``kernels.packed.contiguous``: the strides are
+    a tuple made at each reading here, 30 ns an array).  Alignment is not asked (it costs
+    as much as the rest): numba's code reads a float64 with no more than 8-byte alignment
     assumed, which x86-64 and AArch64 load from any address (tests/test_merging.py runs
     an unaligned array through).  The hottest methods write this test inline for their
     arguments: a call costs as much as the test."""
-    return type(x) is ND and x.dtype is F64 and x.strides == STRIDES
+    return type(x) is ND and x.dtype is F64 and x.ndim == 1
 
 
 def freeze(model, key, kernel, packed, args, *rest):

@@ -12,9 +12,12 @@ from ..errors import NonFiniteError
 from ..kernels import dynamics as kd
 from ..kernels import entries as ke
 from .inputs import plain as _plain
-from .inputs import F64, ND, STRIDES
+from .inputs import F64, ND
 from .inputs import empty as _empty
 from .inputs import freeze as _freeze
+from .recycling import FREE as _FREE
+from .recycling import refcount as _refcount
+from .recycling import spares
 from ..kernels import packed as kp
 
 
@@ -34,10 +37,15 @@ def mass_matrix(model, q, t=0.0):
     in one compiled call (``kernels.inverse``: each joint's motion subspace, no full
     Jacobians, O(n depth)) on the merged tree (``compiled.merging``)."""
     call = model._fast_mass_matrix
-    if call is not None and type(q) is ND and q.dtype is F64 and q.strides == STRIDES:
+    if call is not None and type(q) is ND and q.dtype is F64 and q.ndim == 1:
         # an array of the compiled type (inputs.fits): its entry, no dispatch (freeze)
-        kernel, fb, ib, shape = call
-        M = _empty(shape)
+        kernel, fb, ib, shape, spare = call
+        M = spare[0]                # a result the caller let go of (recycling)
+        if _refcount(M) != _FREE:
+            M = spare[1]
+            if _refcount(M) != _FREE:    # both still held: a new one
+                spare[0] = M
+                M = spare[1] = _empty(shape)
         try:
             if kernel(fb, ib, q, M) == -1:
                 return M
@@ -66,7 +74,7 @@ def mass_matrix(model, q, t=0.0):
         raise NonFiniteError(f"model {model.name!r}, t={t:.6g}: the mass matrix came out "
                              "non-finite (check masses, inertias and drives)")
     if not model._python_inputs:
-        _freeze(model, "mass matrix", entry, (fb, ib), (q, M), M.shape)
+        _freeze(model, "mass matrix", entry, (fb, ib), (q, M), M.shape, spares(M.shape))
     return M
 
 

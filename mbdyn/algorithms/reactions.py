@@ -12,11 +12,14 @@ from ..kernels import dynamics as kd
 from ..kernels import inverse as ki
 from .inputs import plain as _plain
 from .forward_dynamics import ARTICULATED_FROM, METHODS
-from .inputs import F64, ND, STRIDES
+from .inputs import F64, ND
 from .inputs import empty as _empty
 from .inputs import freeze as _freeze
 from .loop_newton_euler import loop_newton_euler_reactions
 from .newton_euler import tree_order
+from .recycling import FREE as _FREE
+from .recycling import refcount as _refcount
+from .recycling import spares
 from .loop_reactions import child_rotation, loop_reactions
 
 
@@ -107,10 +110,15 @@ def effort_array(model, q, u, u_dot, t=0.0):
     call = model._fast_efforts
     if (call is not None and type(q) is ND and type(u) is ND and type(u_dot) is ND
             and q.dtype is F64 and u.dtype is F64 and u_dot.dtype is F64
-            and q.strides == STRIDES and u.strides == STRIDES and u_dot.strides == STRIDES):
+            and q.ndim == 1 and u.ndim == 1 and u_dot.ndim == 1):
         # arrays of the compiled type (inputs.fits): its entry, no dispatch (freeze)
-        kernel, fb, ib, forces, nu = call
-        tau = _empty(nu)
+        kernel, fb, ib, forces, nu, spare = call
+        tau = spare[0]              # a result the caller let go of (recycling)
+        if _refcount(tau) != _FREE:
+            tau = spare[1]
+            if _refcount(tau) != _FREE:  # both still held: a new one
+                spare[0] = tau
+                tau = spare[1] = _empty(nu)
         try:
             if kernel(fb, ib, forces, q, u, u_dot, tau) == -1:
                 return tau
@@ -148,7 +156,7 @@ def _efforts(model, packed, q, u, u_dot, t, key=None):
         model._check_finite(q, u, t, tau, "the inverse dynamics")
     if key is not None and not model._python_inputs and model._con is None:
         _freeze(model, key, ki.inverse_dynamics_packed, packed,
-                (q, u, np.require(u_dot, float, "CW"), tau), model.nu)
+                (q, u, np.require(u_dot, float, "CW"), tau), model.nu, spares(model.nu))
     return tau
 
 

@@ -8,9 +8,8 @@ stderr, before the silent wait::
     from the cache; `mbdyn warmup` compiles them all ahead of time)
 
 and, on a terminal, shows which kernel it is compiling and for how long, then how long it
-took in all.  Two parts, because the notice must come within a second of the command's
-start and the first compile begins only after the imports and the model's reading (about
-1.5 s on a busy 2-core machine):
+took in all.  Two parts: the notice must come within a second of the command's start, and
+the first compile begins after the imports and the model's reading (1.5 s on 2 busy cores):
 
 * ``announce_if_cold(command, argv)``, before anything heavy is imported: looks for the
   cache index files (``*.nbi``) of the kernels the command always calls (``CORE``) where
@@ -67,15 +66,16 @@ FEATURE_KERNELS = {
 #: estimate's source.  Others count ``OTHER`` seconds.  A closed loop's two count its
 #: route's function too (``kernels.route_entry``: the loops and stages are the tree's, its
 #: multipliers for the reactions go through the function), a four-bar's first run after a
-#: tree's: 27 s (two thirds of the 40 s before the routes went by address); only kernels
-#: every closed loop's run compiles are looked for, or a warm run would be told it
-#: compiles; force elements count their function (``kernels.force_function``: the routes
-#: and loops are the same as without)
+#: tree's: 27 s; only kernels every closed loop's run compiles are looked for, or a warm
+#: run would be told it compiles; force elements count their function.  The C functions
+#: (``kernels.c_function``) by shown name, with all they call, for when one comes first
 SECONDS = {"kinematics_and_loads": 2.6, "jourdain_terms": 1.3, "cholesky_solve": 0.8,
-           "stage": 2.7, "rk_stretch": 3.2,
+           "stage": 2.7, "rk_stretch": 3.2, "implicit_midpoint_loop": 6.6,
            "semi_implicit_euler_loop": 3.1, "euler_loop": 3.0, "rk4_loop": 3.9,
-           "implicit_midpoint_loop": 6.6,
-           "constraint_state": 7.0, "project_state_call": 20.0, "force_elements": 5.0}
+           "constraint_state": 7.0, "project_state_call": 20.0, "force_elements": 5.0,
+           "route_entry._articulated": 17.0, "route_entry._closed": 27.0,
+           "route_entry._articulated_closed": 27.0, "force_function._plain": 13.0,
+           "force_function._shapes": 13.0}
 OTHER = 5.0
 #: what a simulation compiles besides its integrator (the reactions' Newton-Euler system,
 #: the energies, the drives' programs)

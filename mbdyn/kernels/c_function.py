@@ -25,14 +25,20 @@ class _ReportedCFunc(CFunc):
 
     @property
     def shown_name(self):
-        """``module.function`` for the progress line: its functions' names are short."""
-        return f"{self._pyfunc.__module__.rsplit('.', 1)[-1]}.{self._pyfunc.__qualname__}"
+        """``shown_name`` of the Python function compiled."""
+        return shown_name(self._pyfunc)
 
     def _compile_uncached(self):
         data = {"dispatcher": self, "args": self._sig.args,
                 "return_type": self._sig.return_type}
         with event.trigger_event("numba:compile", data=data):
             return super()._compile_uncached()
+
+
+def shown_name(function):
+    """``module.function`` for the progress line (its functions' names are short) and the
+    compile notice's estimate (``cli.compiling.SECONDS``)."""
+    return f"{function.__module__.rsplit('.', 1)[-1]}.{function.__qualname__}"
 
 
 def c_function(signature, function, cache=False, **options):

@@ -30,7 +30,7 @@ from .loop_jacobians import constrained_jacobians
 from .loop_solve import (ROWS, augmented_solve, chosen_solve, constrained_solve, rank_of,
                          solve_work)
 from .min_norm import min_norm_step
-from .packed import WRONG_SIZE, _scatter, _views
+from .packed import WRONG_SIZE, _scatter, _views, contiguous
 from .views import CACHED, UNCOUNTED, c_view, untracked
 from .internal import internal
 
@@ -219,7 +219,7 @@ def constrained_accelerations_packed(fb, ib, forces, con_int, cf, q, u):
     ``u`` of another size; ``u'`` in the ``ud`` view, ``lam`` in the constraints'
     workspace)."""
     t = ib
-    if q.shape[0] != t[7] or u.shape[0] != t[1]:
+    if not (contiguous(q, t[7]) and contiguous(u, t[1])):
         return WRONG_SIZE
     _scatter(fb, ib, t, q, u)
     tree, body, state, loads, _, motion, jourdain, art, scratch = _views(fb, ib, t, forces)

@@ -50,7 +50,8 @@ def direct(kernel, args):
     The wrapper unboxes each argument as the type it was compiled for *without checking
     it* (an int64 array would be read as float64, a 2-d one overrun), so the caller
     passes only arrays it has checked to be of those types (``algorithms.inputs.fits``)
-    and its own buffers.  ``None`` when ``kernel`` has no such specialization."""
+    and its own buffers; a 1-d array's strides the packed kernels check
+    (``packed.contiguous``).  ``None`` when ``kernel`` has no such specialization."""
     compiled = kernel.overloads.get(tuple(typeof(a) for a in args))
     return None if compiled is None else compiled.entry_point
 

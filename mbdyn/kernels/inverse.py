@@ -23,7 +23,7 @@ from .dynamics import cholesky_solve
 from .evaluate import motion_and_loads, outcome
 from .joints import NU, REVOLUTE
 from .motion import cross, motion, row3
-from .packed import FREE_Q, FREE_U, UDFULL, WRONG_SIZE, _scatter, _views
+from .packed import FREE_Q, FREE_U, UDFULL, WRONG_SIZE, _scatter, _views, contiguous
 from .spatial import body_inertia
 from .views import FUSED, UNCOUNTED
 from .internal import internal
@@ -216,7 +216,8 @@ def inverse_dynamics_packed(fb, ib, forces, q, u, ud, tau):
     integer buffer stands for the offset table (``packed.articulated_accelerations_packed``)."""
     t = ib
     nu = t[1]
-    if q.shape[0] != t[7] or u.shape[0] != nu or ud.shape[0] != nu or tau.shape[0] != nu:
+    if not (contiguous(q, t[7]) and contiguous(u, nu) and contiguous(ud, nu)
+            and tau.shape[0] == nu):
         return WRONG_SIZE
     _scatter(fb, ib, t, q, u)
     udfull, free_u = fb[t[UDFULL]:], ib[t[FREE_U]:]
@@ -243,7 +244,7 @@ def mass_matrix_packed(fb, ib, forces, q, M):
     (the integer buffer standing for the table)."""
     t = ib
     nu = t[1]
-    if q.shape[0] != t[7] or M.shape[0] != nu or M.shape[1] != nu:
+    if not contiguous(q, t[7]) or M.shape[0] != nu or M.shape[1] != nu:
         return WRONG_SIZE
     tree, body, state, _, _, kin, _, art, scratch = _views(fb, ib, t, None)
     qfull = state[0]

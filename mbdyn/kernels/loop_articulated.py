@@ -30,7 +30,7 @@ from .evaluate import articulated_accelerations, motion_and_loads, outcome
 from .joints import NU
 from .loop_jacobians import constrained_jacobians
 from .loop_solve import PASSAGE_TOLERANCE, RANK_TOLERANCE, ROWS
-from .packed import WRONG_SIZE, _scatter, _views
+from .packed import WRONG_SIZE, _scatter, _views, contiguous
 from .rank_qr import pivoted_qr, residual_rows
 from .views import UNCOUNTED, c_view
 
@@ -271,7 +271,7 @@ def constrained_articulated_packed(fb, ib, forces, con_int, cf, q, u):
     those of the tree's entry (``evaluate.motion_and_loads``); ``WRONG_SIZE`` for ``q`` or
     ``u`` of another size."""
     t = ib
-    if q.shape[0] != t[7] or u.shape[0] != t[1]:
+    if not (contiguous(q, t[7]) and contiguous(u, t[1])):
         return WRONG_SIZE
     _scatter(fb, ib, t, q, u)
     tree, body, state, loads, _, kin, jourdain, art, scratch = _views(fb, ib, t, forces)

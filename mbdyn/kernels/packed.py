@@ -34,8 +34,18 @@ from .forces import ROW
 from .joints import coordinate_rates
 from .views import CACHED, UNCOUNTED, c_view, far_view, untracked
 
-#: what a packed entry returns for an argument of the wrong size (before it reads it)
+#: what a packed entry returns for an argument of the wrong size, or not contiguous
+#: (before it reads it)
 WRONG_SIZE = -3
+
+
+@njit(inline="always", **UNCOUNTED)
+def contiguous(x, n):
+    """Whether the 1-d float64 argument ``x`` holds ``n`` values side by side.  Its type
+    says contiguous, but the ordinary methods call the entries with no dispatch
+    (``entries.direct``), which hands over the caller's array unchecked: its strides are
+    read as they are (a 1-d array of stride 16 or -8 would otherwise be misread)."""
+    return x.shape[0] == n and (n < 2 or x.strides[0] == 8)
 
 #: float arrays in buffer order, with their shapes in terms of the sizes below
 FLOATS = ("gravity", "axis", "pos", "C", "mass", "com", "inertia", "load_point", "load_force",
@@ -261,7 +271,7 @@ def jourdain_accelerations_packed(fb, ib, forces, q, u):
     the ``ud`` view).  The integer buffer stands for the offset table, as in
     ``articulated_accelerations_packed``."""
     t = ib
-    if q.shape[0] != t[7] or u.shape[0] != t[1]:
+    if not (contiguous(q, t[7]) and contiguous(u, t[1])):
         return WRONG_SIZE
     _scatter(fb, ib, t, q, u)
     tree, body, state, loads, _, motion, jourdain, _, scratch = _views(fb, ib, t, forces)
@@ -321,7 +331,7 @@ def articulated_accelerations_packed(fb, ib, forces, q, u):
     view.  The integer buffer stands for the offset table (its head, ``pack``): an
     argument less for numba to check at each call from Python."""
     t = ib
-    if q.shape[0] != t[7] or u.shape[0] != t[1]:
+    if not (contiguous(q, t[7]) and contiguous(u, t[1])):
         return WRONG_SIZE
     _scatter(fb, ib, t, q, u)
     tree, body, state, loads, _, kin, jourdain, art, scratch = _views(fb, ib, t, forces)

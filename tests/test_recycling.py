@@ -1,0 +1,86 @@
+"""The mass matrix and the generalized forces come back as new arrays, some of them
+recycled (``algorithms.recycling``): a result the caller still reaches is never written, and
+one it let go of is taken back."""
+import gc
+import weakref
+
+import numpy as np
+import pytest
+
+from mbdyn.algorithms import recycling
+from test_merging import robot, state
+
+
+@pytest.fixture(scope="module")
+def frozen():
+    """A model whose two hot methods have their direct calls (``inputs.freeze``), states,
+    and the results at them, computed by the checked route (a list as input)."""
+    model = robot(loads=True).compile()
+    q, u, ud = state(model)
+    q2, u2, ud2 = state(model, seed=2)
+    for _ in range(2):
+        model.mass_matrix(q), model.effort_array(q, u, ud)
+    assert model._fast_mass_matrix is not None and model._fast_efforts is not None
+    checked = {"M": model.mass_matrix(list(q)), "M2": model.mass_matrix(list(q2)),
+               "tau": model.effort_array(list(q), u, ud),
+               "tau2": model.effort_array(list(q2), u2, ud2)}
+    return model, (q, u, ud), (q2, u2, ud2), checked
+
+
+def calls(model, a, b):
+    """The two methods at the states ``a`` and ``b``, by their direct calls."""
+    return ((lambda: model.mass_matrix(a[0]), lambda: model.mass_matrix(b[0]), "M", "M2"),
+            (lambda: model.effort_array(*a), lambda: model.effort_array(*b), "tau", "tau2"))
+
+
+def test_a_result_the_caller_reaches_is_never_written(frozen):
+    model, a, b, checked = frozen
+    for first, other, key, key2 in calls(model, a, b):
+        kept = first()
+        row = first()[0]                 # a view: reaches its array through .base
+        listed = [first() for _ in range(3)]
+        view = np.asarray(first())
+        for _ in range(5):
+            other()                      # discarded: free to recycle
+            held = other()
+        assert np.array_equal(held, checked[key2])
+        for result in (kept, view, *listed):
+            assert np.array_equal(result, checked[key])
+        assert np.array_equal(row, checked[key][0])
+        assert len({id(r) for r in (kept, view, *listed, held)}) == 6
+
+
+def test_each_call_in_a_loop_is_right(frozen):
+    model, a, b, checked = frozen
+    for first, other, key, key2 in calls(model, a, b):
+        result = None
+        for k in range(6):               # the name holds the last result during the call
+            result = (first if k % 2 else other)()
+            assert np.array_equal(result, checked[key if k % 2 else key2])
+
+
+@pytest.mark.skipif(recycling.FREE == -1, reason="reference counts not exact here: "
+                    "results are never recycled")
+def test_a_result_let_go_of_is_taken_back(frozen):
+    model, a, b, checked = frozen
+    for first, other, key, _ in calls(model, a, b):
+        result = first()
+        ref = weakref.ref(result)        # does not hold it
+        del result
+        gc.collect()
+        again = first()
+        assert again is ref()
+        assert np.array_equal(again, checked[key])
+
+
+def test_the_count_of_a_free_spare_is_calibrated():
+    """The count the hot paths compare against is the one a spare nothing else refers to
+    has; one more reference (the caller's) makes it differ."""
+    if recycling.FREE == -1:
+        pytest.skip("reference counts not exact here")
+    spare = recycling.spares(2)
+    result = spare[0]
+    assert recycling.refcount(result) == recycling.FREE
+    held = spare[0]
+    assert recycling.refcount(result) == recycling.FREE + 1
+    del held
