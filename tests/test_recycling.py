@@ -2,6 +2,10 @@
 recycled (``algorithms.recycling``): a result the caller still reaches is never written, and
 one it let go of is taken back."""
 import gc
+import subprocess
+import sys
+import textwrap
+import warnings
 import weakref
 
 import numpy as np
@@ -84,3 +88,62 @@ def test_the_count_of_a_free_spare_is_calibrated():
     held = spare[0]
     assert recycling.refcount(result) == recycling.FREE + 1
     del held
+
+
+def _alter(x, how):
+    """``x`` made read-only, re-typed or re-strided in place (True), or False where this
+    numpy refuses the change."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            if how == "read-only":
+                x.flags.writeable = False
+            elif how == "dtype":
+                x.dtype = np.int64
+            else:                        # the same bytes, read with other strides
+                x.strides = tuple(reversed(x.strides)) if x.ndim == 2 else (0,)
+    except (AttributeError, ValueError, TypeError):
+        return False
+    return True
+
+
+@pytest.mark.parametrize("how", ["read-only", "dtype", "strides"])
+def test_a_result_altered_then_let_go_of_does_not_come_back_altered(frozen, how):
+    """A caller may make its result read-only, or set its dtype or strides, before letting
+    go of it: the next results are still writable float64 arrays of the right numbers."""
+    model, a, b, checked = frozen
+    for first, _, key, _ in calls(model, a, b):
+        altered = 0
+        for _ in range(3):               # both spares altered in turn, then new ones
+            result = first()
+            altered += _alter(result, how)
+            del result
+        if not altered:
+            pytest.skip(f"this numpy does not let {how} be changed in place")
+        for _ in range(3):
+            result = first()
+            assert result.dtype == np.float64 and result.flags.writeable
+            assert result.flags.c_contiguous
+            assert np.array_equal(result, checked[key])
+
+
+def test_a_tracer_at_import_switches_recycling_off_rather_than_miscount():
+    """A trace function that reads the frames' locals holds one more reference to each
+    local: calibrated under it, the count of a free spare would be one too high, and an
+    array the caller still holds would be taken for free."""
+    script = textwrap.dedent("""
+        import sys
+
+        def tracer(frame, event, arg):
+            frame.f_locals
+            return tracer
+        sys.settrace(tracer)
+        from mbdyn.algorithms import recycling
+        sys.settrace(None)
+        print(recycling.FREE)
+    """)
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                         check=True).stdout.split()
+    assert out[-1] in (str(recycling.EXPECTED), "-1")
+    if recycling.FREE != -1:
+        assert out[-1] == "-1"           # the tracer did add one here: not kept

@@ -40,11 +40,11 @@ def mass_matrix(model, q, t=0.0):
     if call is not None and type(q) is ND and q.dtype is F64 and q.ndim == 1:
         # an array of the compiled type (inputs.fits): its entry, no dispatch (freeze)
         kernel, fb, ib, shape, spare = call
-        M = spare[0]                # a result the caller let go of (recycling)
-        if _refcount(M) != _FREE:
+        M = spare[0]       # a result the caller let go of, as it was made (recycling)
+        if _refcount(M) != _FREE or M.dtype is not F64 or not M.flags.writeable:
             M = spare[1]
-            if _refcount(M) != _FREE:    # both still held: a new one
-                spare[0] = M
+            if _refcount(M) != _FREE or M.dtype is not F64 or not M.flags.writeable:
+                spare[0] = M             # both held or altered: a new one
                 M = spare[1] = _empty(shape)
         try:
             if kernel(fb, ib, q, M) == -1:

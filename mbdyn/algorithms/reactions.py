@@ -113,11 +113,11 @@ def effort_array(model, q, u, u_dot, t=0.0):
             and q.ndim == 1 and u.ndim == 1 and u_dot.ndim == 1):
         # arrays of the compiled type (inputs.fits): its entry, no dispatch (freeze)
         kernel, fb, ib, forces, nu, spare = call
-        tau = spare[0]              # a result the caller let go of (recycling)
-        if _refcount(tau) != _FREE:
+        tau = spare[0]       # a result the caller let go of, as it was made (recycling)
+        if _refcount(tau) != _FREE or tau.dtype is not F64 or not tau.flags.writeable:
             tau = spare[1]
-            if _refcount(tau) != _FREE:  # both still held: a new one
-                spare[0] = tau
+            if _refcount(tau) != _FREE or tau.dtype is not F64 or not tau.flags.writeable:
+                spare[0] = tau             # both held or altered: a new one
                 tau = spare[1] = _empty(nu)
         try:
             if kernel(fb, ib, forces, q, u, u_dot, tau) == -1:

@@ -11,7 +11,10 @@ leaves the spares at the next call that finds both held.
 
 No array the caller can still reach is ever written: a name, a list, a view
 (``M[0]``, ``M.T``), a memoryview or ``np.asarray`` all hold a reference (a weak
-reference and a raw pointer, ``M.ctypes.data``, do not).  Where the count
+reference and a raw pointer, ``M.ctypes.data``, do not).  A spare is taken back only as the
+model made it, float64 and writable: the caller may have set its ``dtype`` or made it
+read-only before letting go.  Its shape and strides the kernels check (``WRONG_SIZE``:
+the checked route, which makes new spares).  Where the count
 is not exact, the arrays are never recycled (``FREE = -1``): on another interpreter, on a
 free-threaded CPython, and from 3.14, whose interpreter may borrow a local's reference
 without counting it.
@@ -28,13 +31,13 @@ refcount = sys.getrefcount
 
 
 def spares(shape):
-    """The model's two recycled results of ``shape``: ``[older, newer]``."""
+    """The model's two recycled results of ``shape``."""
     return [np.empty(shape), np.empty(shape)]
 
 
 def _count_when_free():
     """``refcount`` of a spare that only the model refers to, taken as the hot paths
-    take it: the list's reference, the local name's, the argument's."""
+    take it."""
     spare = spares(0)
     result = spare[0]
     return refcount(result)
@@ -47,5 +50,13 @@ def _exact_counts():
             and not sysconfig.get_config_var("Py_GIL_DISABLED"))
 
 
-#: ``refcount`` of a spare free to recycle (the hot paths compare ``!= FREE``; -1: never)
-FREE = _count_when_free() if _exact_counts() else -1
+#: the count of a free spare in the hot paths: the list's reference, the local name's and
+#: the argument's
+EXPECTED = 3
+#: ``refcount`` of a spare free to recycle (the hot paths compare ``!= FREE``; -1: never).
+#: Measured, and kept only when it is ``EXPECTED``: a tracer that reads the frames' locals
+#: (a debugger stepping through this import) adds one, and a count calibrated one too high
+#: would take an array the caller still holds for free.  Under such a tracer later, a
+#: count only errs towards allocating.
+FREE = EXPECTED if _exact_counts() and _count_when_free() == EXPECTED else -1
+

@@ -217,7 +217,7 @@ def inverse_dynamics_packed(fb, ib, forces, q, u, ud, tau):
     t = ib
     nu = t[1]
     if not (contiguous(q, t[7]) and contiguous(u, nu) and contiguous(ud, nu)
-            and tau.shape[0] == nu):
+            and contiguous(tau, nu)):
         return WRONG_SIZE
     _scatter(fb, ib, t, q, u)
     udfull, free_u = fb[t[UDFULL]:], ib[t[FREE_U]:]
@@ -244,7 +244,8 @@ def mass_matrix_packed(fb, ib, forces, q, M):
     (the integer buffer standing for the table)."""
     t = ib
     nu = t[1]
-    if not contiguous(q, t[7]) or M.shape[0] != nu or M.shape[1] != nu:
+    if not (contiguous(q, t[7]) and M.shape[0] == nu and M.shape[1] == nu
+            and (nu < 2 or (M.strides[0] == 8 * nu and M.strides[1] == 8))):
         return WRONG_SIZE
     tree, body, state, _, _, kin, _, art, scratch = _views(fb, ib, t, None)
     qfull = state[0]
