@@ -4,9 +4,9 @@ little (``compiled.lowlevel``).
 numba checks every argument of a compiled function at each call; a function compiled for
 one explicit signature (contiguous, writable float64 arrays and the packed model's integer
 buffer) does that fastest and refuses any other type at once (``TypeError``) instead of
-compiling for it.  Each entry checks the sizes before it touches the buffers (returns
-``WRONG_SIZE``) and returns the kernel's status: -1 on success, a speed's column where a
-degree of freedom has no inertia, -2 for a non-finite result.
+compiling for it.  Each entry, or the kernel it calls, checks the sizes before it touches
+the buffers (returns ``WRONG_SIZE``) and returns the kernel's status: -1 on success, a
+speed's column where a degree of freedom has no inertia, -2 for a non-finite result.
 
 The integer buffer ``ib`` starts with the offset table (``packed.pack``) and stands for it:
 one array less to type and unbox at every call; the force table is its view
@@ -58,18 +58,13 @@ def direct(kernel, args):
 
 def inverse_dynamics(fb, ib, q, u, ud, tau):
     """Generalized forces ``tau = M u' - f`` on the free speeds, and the joint wrenches in
-    the packed ``W`` view (``inverse.inverse_dynamics_packed``)."""
-    nu = ib[1]
-    if q.shape[0] != ib[7] or u.shape[0] != nu or ud.shape[0] != nu or tau.shape[0] != nu:
-        return WRONG_SIZE
+    the packed ``W`` view (``inverse.inverse_dynamics_packed``, which checks the sizes)."""
     return ki.inverse_dynamics_packed(fb, ib, kp.force_table(ib, ib), q, u, ud, tau)
 
 
 def mass_matrix(fb, ib, q, M):
-    """The mass matrix at ``q`` into ``M`` (``inverse.mass_matrix_packed``)."""
-    nu = ib[1]
-    if q.shape[0] != ib[7] or M.shape[0] != nu or M.shape[1] != nu:
-        return WRONG_SIZE
+    """The mass matrix at ``q`` into ``M`` (``inverse.mass_matrix_packed``, which checks
+    the sizes)."""
     return ki.mass_matrix_packed(fb, ib, None, q, M)
 
 
