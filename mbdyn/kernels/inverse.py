@@ -164,7 +164,7 @@ def composite_mass_matrix_s(mass, com, inertia, parent, kind, ucol, R, r, S, IC,
             M[j, k] = M[k, j]
 
 
-@internal(**FUSED)
+@internal(forceinline=True, **FUSED)
 def _add_about_parent(IC, i, p, x, y, z):
     """Add the rigid inertia ``IC[i]`` (``composite_mass_matrix_s``'s layout), moved from
     ``O_i`` to ``O_p`` (``rho = (x, y, z) = O_i - O_p``), to ``IC[p]``: the mass, ``h +

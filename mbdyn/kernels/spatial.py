@@ -13,7 +13,7 @@ from .motion import mat9, mv
 from .views import FUSED
 from .internal import internal
 
-@internal(**FUSED)
+@internal(forceinline=True, **FUSED)
 def body_inertia(R, com, inertia, i):
     """Frame ``i``'s centre of mass ``c = R com`` from its origin (3-tuple) and its inertia
     about the centre of mass in world axes ``Iw = R I R^T`` as a 6-tuple ``(xx, xy, xz,
@@ -34,7 +34,7 @@ def body_inertia(R, com, inertia, i):
                y[6] * Ri[6] + y[7] * Ri[7] + y[8] * Ri[8])
 
 
-@internal(**FUSED)
+@internal(forceinline=True, **FUSED)
 def rigid_upper(IA, i, m, c, Iw):
     """The upper triangle of a rigid body's spatial inertia at its frame's origin into
     ``IA[i]`` (the module docstring)."""
@@ -52,7 +52,7 @@ def rigid_upper(IA, i, m, c, Iw):
     IA[i, 3, 4] = IA[i, 3, 5] = IA[i, 4, 5] = 0.0
 
 
-@internal(**FUSED)
+@internal(forceinline=True, **FUSED)
 def mirror(IA, i):
     """``IA[i]``'s lower triangle from its upper one."""
     for a_ in range(1, 6):
@@ -60,7 +60,7 @@ def mirror(IA, i):
             IA[i, a_, b_] = IA[i, b_, a_]
 
 
-@internal(**FUSED)
+@internal(forceinline=True, **FUSED)
 def shift_upper(IA, i, p, x, y, z):
     """``IA[p] += X^T IA[i] X`` on the upper triangles: the child's block moved from its
     origin to its parent's, ``(x, y, z)`` the child's origin from the parent's.  With
