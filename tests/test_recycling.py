@@ -12,29 +12,54 @@ import numpy as np
 import pytest
 
 from mbdyn.algorithms import recycling
+from mbdyn.kernels import fastcall
+from test_fastcall import made
 from test_merging import robot, state
 
 
-@pytest.fixture(scope="module")
-def frozen():
+@pytest.fixture(scope="module", params=["C", "Python"])
+def frozen(request):
+    with pytest.MonkeyPatch.context() as patch:
+        if request.param == "Python":    # as where the extension is not built
+            patch.setenv("MBDYN_FASTCALL", "0")
+        yield _frozen(request)
+
+
+def _frozen(request):
     """A model whose two hot methods have their direct calls (``inputs.freeze``), states,
-    and the results at them, computed by the checked route (a list as input)."""
+    and the results at them, computed by the checked route (a list as input).  Twice:
+    with the C entries (``kernels.fastcall``), which recycle in C, and without them, as
+    where the extension is not built (the Python fast path recycles)."""
     model = robot(loads=True).compile()
     q, u, ud = state(model)
     q2, u2, ud2 = state(model, seed=2)
     for _ in range(2):
         model.mass_matrix(q), model.effort_array(q, u, ud)
+        model.forward_dynamics(q, u, method="articulated")
     assert model._fast_mass_matrix is not None and model._fast_efforts is not None
+    if request.param == "C":
+        if not fastcall.enabled():
+            pytest.skip("mbdyn.kernels._fastcall is not built here")
+        made(model)
+        assert isinstance(model._c_mass_matrix, fastcall.Entry)
+        assert isinstance(model._c_efforts, fastcall.Entry)
+    else:
+        assert model._c_mass_matrix is None and model._c_efforts is None
     checked = {"M": model.mass_matrix(list(q)), "M2": model.mass_matrix(list(q2)),
                "tau": model.effort_array(list(q), u, ud),
-               "tau2": model.effort_array(list(q2), u2, ud2)}
+               "tau2": model.effort_array(list(q2), u2, ud2),
+               "fd": model.forward_dynamics(list(q), u, method="articulated"),
+               "fd2": model.forward_dynamics(list(q2), u2, method="articulated")}
     return model, (q, u, ud), (q2, u2, ud2), checked
 
 
 def calls(model, a, b):
-    """The two methods at the states ``a`` and ``b``, by their direct calls."""
+    """The three methods at the states ``a`` and ``b``, by their direct calls."""
+    def fd(x):
+        return lambda: model.forward_dynamics(x[0], x[1], method="articulated")
     return ((lambda: model.mass_matrix(a[0]), lambda: model.mass_matrix(b[0]), "M", "M2"),
-            (lambda: model.effort_array(*a), lambda: model.effort_array(*b), "tau", "tau2"))
+            (lambda: model.effort_array(*a), lambda: model.effort_array(*b), "tau", "tau2"),
+            (fd(a), fd(b), "fd", "fd2"))
 
 
 def test_a_result_the_caller_reaches_is_never_written(frozen):
@@ -65,7 +90,8 @@ def test_each_call_in_a_loop_is_right(frozen):
 
 def test_a_result_let_go_of_is_taken_back(frozen):
     """Taken back where reference counts are exact; where they are not (``FREE`` -1)
-    every call allocates, and a result let go of is never handed out again."""
+    every call allocates, and a result let go of is never handed out again.  The forward
+    dynamics recycles only in its C entry (its Python route copies the workspace)."""
     model, a, b, checked = frozen
     for first, other, key, _ in calls(model, a, b):
         result = first()
@@ -73,7 +99,9 @@ def test_a_result_let_go_of_is_taken_back(frozen):
         del result
         gc.collect()
         again = first()
-        assert (again is ref()) == (recycling.FREE != -1)
+        recycles = recycling.FREE != -1 and (
+            key != "fd" or isinstance(model._c_forward["articulated"], fastcall.Entry))
+        assert (again is ref()) == recycles
         assert np.array_equal(again, checked[key])
 
 

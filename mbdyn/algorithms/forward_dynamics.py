@@ -13,6 +13,7 @@ from ..kernels import packed as kp
 from .inputs import F64, ND
 from .inputs import freeze as _freeze
 from .inputs import plain as _plain
+from .c_entries import pending
 from .constrained import fast_call as closed_fast_call
 from .route_hook import loop_route
 from .loop_newton_euler import loop_newton_euler
@@ -38,6 +39,11 @@ def forward_dynamics(model, q, u, t=0.0, method="auto"):
     solved by LU (``"newton-euler-dense"``).  All four solve the same equations;
     ``"auto"`` (the default) takes the fastest at the model's size (``formulation``,
     docs/performance.md)."""
+    call = model._c_forward.get(method)
+    if call is not None:                 # one C call (kernels.fastcall); None: not taken
+        ud = call(q, u)
+        if ud is not None:
+            return ud
     call = model._fast_calls.get(method)
     if (call is not None and type(q) is ND and type(u) is ND and q.dtype is F64
             and u.dtype is F64 and q.ndim == 1 and u.ndim == 1):
@@ -102,6 +108,10 @@ def _accelerations(model, q, u, t, method, key=None):
         model._check_finite(q, u, t, ud, "the accelerations")
     if key is not None and not model._python_inputs:
         _freeze(model, key, kernel, packed, (q, u), ud)
+        if method == "articulated" and model._c_forward.get(key) is None:
+            # and one C call once called often (c_entries); kept through later checked calls
+            model._c_forward[key] = pending(model, "articulated", packed,
+                                            lambda entry: model._c_forward.update({key: entry}))
     return ud.copy()
 
 

@@ -11,6 +11,7 @@ import numpy as np
 from ..errors import ModelError, NonFiniteError, SingularMassMatrixError
 from ..kernels import forces as kf
 from ..kernels.entries import direct
+from .c_entries import pending
 
 
 def fill(model, q, u, t):
@@ -86,11 +87,18 @@ def freeze(model, key, kernel, packed, args, *rest):
         model._fast_calls[key] = (call, *packed, *rest)
         if key in FAST_ATTRIBUTES:           # the hottest: an attribute, not a dict lookup
             setattr(model, FAST_ATTRIBUTES[key], model._fast_calls[key])
+    name = C_ATTRIBUTES.get(key)
+    if name is not None and getattr(model, name) is None:
+        # and one C call once called often (c_entries); kept through later checked calls
+        setattr(model, name, pending(model, key, packed,
+                                     lambda entry: setattr(model, name, entry)))
 
 
 #: the fast calls also held as attributes of the model (``freeze``; None until then): a
 #: dictionary lookup is 5 % of a mass matrix of twelve speeds
 FAST_ATTRIBUTES = {"mass matrix": "_fast_mass_matrix", "efforts": "_fast_efforts"}
+#: the same two as one C call each (``kernels.fastcall``; None without the extension)
+C_ATTRIBUTES = {"mass matrix": "_c_mass_matrix", "efforts": "_c_efforts"}
 
 
 def state(model, q, u):

@@ -36,6 +36,11 @@ def mass_matrix(model, q, t=0.0):
     """The Jourdain mass matrix ``M(q)`` (nu x nu, symmetric), by composite rigid bodies
     in one compiled call (``kernels.inverse``: each joint's motion subspace, no full
     Jacobians, O(n depth)) on the merged tree (``compiled.merging``)."""
+    call = model._c_mass_matrix
+    if call is not None:                 # one C call (kernels.fastcall); None: not taken
+        M = call(q)
+        if M is not None:
+            return M
     call = model._fast_mass_matrix
     if call is not None and type(q) is ND and q.dtype is F64 and q.ndim == 1:
         # an array of the compiled type (inputs.fits): its entry, no dispatch (freeze)

@@ -107,6 +107,11 @@ def effort_array(model, q, u, u_dot, t=0.0):
     efforts without its dictionaries, by the recursive Newton-Euler algorithm in one
     compiled call on the merged tree (O(n), ``compiled.merging``; a closed mechanism by
     ``M u' - f`` of its tree)."""
+    call = model._c_efforts
+    if call is not None:                 # one C call (kernels.fastcall); None: not taken
+        tau = call(q, u, u_dot)
+        if tau is not None:
+            return tau
     call = model._fast_efforts
     if (call is not None and type(q) is ND and type(u) is ND and type(u_dot) is ND
             and q.dtype is F64 and u.dtype is F64 and u_dot.dtype is F64

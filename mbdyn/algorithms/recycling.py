@@ -1,5 +1,7 @@
 """The result arrays of the hottest per-call methods (``mass_matrix``, ``effort_array``),
-recycled once the caller has let go of them.
+recycled once the caller has let go of them.  (Their C entries, ``kernels.fastcall``,
+recycle the same way in C, where the count of a free spare is exactly 1; ``FREE != -1``
+is their switch too.)
 
 Each call returns a new array, which is what a caller may keep.  Allocating it
 (``np.empty``) is an eighth of a 9-speed mass matrix's cost.  So the model keeps two arrays

@@ -86,6 +86,8 @@ class Model:
         #: ``algorithms.inputs.freeze``): filled on first use
         self._fast_calls = {}
         self._fast_mass_matrix = self._fast_efforts = None   # the hottest two, as attributes
+        self._c_mass_matrix = self._c_efforts = None         # and as one C call each
+        self._c_forward = {}         # forward dynamics by articulated bodies, by method
         #: controllers in Python and PID integral terms, updated at their sampling
         #: instants between compiled stretches (``integrate.sampled``)
         self._controllers = tuple(controllers)
