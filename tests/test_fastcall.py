@@ -9,7 +9,7 @@ import sysconfig
 import numpy as np
 import pytest
 
-from mbdyn.algorithms import c_entries
+from mbdyn.algorithms import c_entries, recycling
 from mbdyn.errors import ModelError, NonFiniteError
 from mbdyn.kernels import fastcall
 from test_merging import compiled_pair, robot, state
@@ -197,6 +197,7 @@ def test_the_entry_refuses_buffers_it_cannot_call_with():
         fastcall.Entry(address, 0, list(fb), ib, 0, 1, 1, True)
 
 
+@needs_entry
 def test_switched_off_by_the_environment(monkeypatch):
     monkeypatch.setenv("MBDYN_FASTCALL", "0")
     assert not fastcall.enabled()
@@ -207,3 +208,82 @@ def test_switched_off_by_the_environment(monkeypatch):
     assert model._c_forward["articulated"] is None
     assert model._fast_mass_matrix is not None   # the Python fast path instead
     assert os.environ["MBDYN_FASTCALL"] == "0"
+
+
+def test_a_model_let_go_of_is_freed_at_once_while_its_entries_are_pending():
+    """The pending entries hold their model weakly: no reference cycle keeps it until the
+    cyclic collector runs (its buffers may be large)."""
+    import gc
+    import weakref
+    model = robot(loads=True).compile()
+    q, u, ud = state(model)
+    for _ in range(3):
+        model.mass_matrix(q), model.effort_array(q, u, ud), model.forward_dynamics(q, u)
+    ref = weakref.ref(model)
+    gc.disable()
+    try:
+        del model
+        assert ref() is None
+    finally:
+        gc.enable()
+
+
+@needs_entry
+def test_a_spare_whose_release_calls_the_entry_again_leaves_it_consistent():
+    """Releasing a spare may run Python code (a weak reference's callback) that calls the
+    same entry: the entry's spares are settled before the release."""
+    import sys
+    import weakref
+    model = made(_frozen(robot().compile(), *state(robot().compile())))
+    q = state(model)[0]
+    M_checked = _checked(model, q, *state(model)[1:])[0]
+    inner = []
+    a = model.mass_matrix(q)
+    b = model.mass_matrix(q)
+    a.shape = (a.size,)                  # no longer a spare's shape: never taken back
+    watch = weakref.ref(a, lambda _: inner.append(model.mass_matrix(q)))
+    del a                                # only the entry holds it now
+    c = model.mass_matrix(q)             # makes a new one, releasing `a`: the callback
+    assert watch() is None and len(inner) == 1
+    assert len({id(b), id(c), id(inner[0])}) == 3
+    # the counts: the name (or list) and the argument, and the entry's for its two spares
+    # (c and the inner call's result; b was moved out)
+    spare = 1 if recycling.FREE != -1 else 0
+    counts = (sys.getrefcount(b), sys.getrefcount(c), sys.getrefcount(inner[0]))
+    assert counts == (2, 2 + spare, 2 + spare)       # (taken outside the assert's rewrite)
+    q2 = state(model, seed=2)[0]
+    for _ in range(4):
+        model.mass_matrix(q2)            # let go of at once: recycled, never one held
+    for result in (b, c, inner[0]):
+        assert np.array_equal(result, M_checked)
+
+
+def test_an_entry_that_cannot_be_made_leaves_the_python_route(monkeypatch):
+    """A C function that fails to compile, or sizes that do not match the buffers: a
+    warning, and the methods answer by their Python route from then on."""
+    model = robot(loads=True).compile()
+    q, u, ud = state(model)
+    M = model.mass_matrix(q)
+    if model._c_mass_matrix is None:
+        pytest.skip("the extension is not built or switched off")
+
+    def broken(*args):
+        raise RuntimeError("no compiler today")
+    monkeypatch.setattr(fastcall, "entry", broken)
+    for _ in range(c_entries.WARM):
+        model.mass_matrix(q)
+    with pytest.warns(RuntimeWarning, match="mass matrix could not be made"):
+        assert np.array_equal(model.mass_matrix(q), M)
+    assert model._c_mass_matrix is c_entries.off
+    assert np.array_equal(model.mass_matrix(list(q)), M)     # a checked call keeps it off
+    assert model._c_mass_matrix is c_entries.off
+
+
+@needs_entry
+def test_the_sizes_must_match_the_buffers():
+    model = robot().compile()
+    fb, ib = model._dynamics[:2]
+    fastcall.entry("mass matrix", fb, ib, 0, model.nq, model.nu, True)
+    for nq, nu in [(model.nq + 1, model.nu), (model.nq, model.nu - 1)]:
+        with pytest.raises(ValueError, match="do not match"):
+            fastcall.entry("mass matrix", fb, ib, 0, nq, nu, True)

@@ -110,8 +110,9 @@ def _accelerations(model, q, u, t, method, key=None):
         _freeze(model, key, kernel, packed, (q, u), ud)
         if method == "articulated" and model._c_forward.get(key) is None:
             # and one C call once called often (c_entries); kept through later checked calls
-            model._c_forward[key] = pending(model, "articulated", packed,
-                                            lambda entry: model._c_forward.update({key: entry}))
+            model._c_forward[key] = pending(
+                model, "articulated", packed,
+                lambda owner, entry: owner._c_forward.update({key: entry}))
     return ud.copy()
 
 

@@ -91,7 +91,7 @@ def freeze(model, key, kernel, packed, args, *rest):
     if name is not None and getattr(model, name) is None:
         # and one C call once called often (c_entries); kept through later checked calls
         setattr(model, name, pending(model, key, packed,
-                                     lambda entry: setattr(model, name, entry)))
+                                     lambda owner, entry: setattr(owner, name, entry)))
 
 
 #: the fast calls also held as attributes of the model (``freeze``; None until then): a

@@ -79,10 +79,11 @@ static PyArrayObject *result(Entry *self)
     }
     PyArrayObject *made = (PyArrayObject *)PyArray_SimpleNew(nd, dims, NPY_DOUBLE);
     if (made != NULL && self->recycle) {    /* the second spare moves to the first place */
-        Py_XDECREF(self->spare[0]);
+        PyArrayObject *old = self->spare[0];
         self->spare[0] = self->spare[1];
         Py_INCREF(made);
         self->spare[1] = made;
+        Py_XDECREF(old);    /* last: its release may run Python code that calls us again */
     }
     return made;
 }

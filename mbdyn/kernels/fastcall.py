@@ -19,6 +19,7 @@ The extension is optional: a machine without a C compiler installs mbdyn without
 """
 import os
 
+import numpy as np
 from numba import carray, types
 
 from . import inverse as ki
@@ -81,9 +82,10 @@ def _articulated(fb, nfb, ib, nib, forces, q, nq, u, nu, u_rate):
                                                      carray(q, (nq,)), carray(u, (nu,)))
     except Exception:
         return RAISED
-    out, ud = carray(u_rate, (nu,)), c_view(floats, ints[kp.UD], (nu,))
-    for k in range(nu):
-        out[k] = ud[k]
+    if status == -1:
+        out, ud = carray(u_rate, (nu,)), c_view(floats, ints[kp.UD], (nu,))
+        for k in range(nu):
+            out[k] = ud[k]
     return status
 
 
@@ -114,4 +116,7 @@ def entry(key, fb, ib, forces, nq, nu, recycle):
     ``recycle``: whether reference counts are exact here (``algorithms.recycling``)."""
     if not enabled():
         return None
+    if not (ib.dtype == np.int64 and ib.shape[0] > 7 and nq == ib[7] and nu == ib[1]):
+        raise ValueError(f"fastcall.entry: nq={nq}, nu={nu} do not match the packed "
+                         "buffers' table")
     return Entry(kernel(key).address, KINDS[key], fb, ib, int(forces), nq, nu, bool(recycle))
