@@ -25,7 +25,6 @@ from numba import carray, types
 from . import inverse as ki
 from . import packed as kp
 from .c_function import c_function
-from .forces import ROW
 from .views import c_view
 
 try:
@@ -63,7 +62,7 @@ def _efforts(fb, nfb, ib, nib, forces, q, nq, u, u_dot, nu, tau):
     """``inverse.inverse_dynamics_packed`` on the buffers and arrays at these addresses,
     the force table a view of the integer buffer (``packed.force_table``)."""
     ints = carray(ib, (nib,))
-    table = c_view(ints, ints[kp.FORCE_INT], (ints[9], ROW))
+    table = kp.force_table(ints, ints)[0]
     try:
         return ki.inverse_dynamics_packed(carray(fb, (nfb,)), ints, (table, forces),
                                           carray(q, (nq,)), carray(u, (nu,)),
@@ -76,7 +75,7 @@ def _articulated(fb, nfb, ib, nib, forces, q, nq, u, nu, u_rate):
     """``packed.articulated_accelerations_packed`` on the buffers and arrays at these
     addresses, ``u'`` copied from the workspace into ``u_rate``."""
     ints, floats = carray(ib, (nib,)), carray(fb, (nfb,))
-    table = c_view(ints, ints[kp.FORCE_INT], (ints[9], ROW))
+    table = kp.force_table(ints, ints)[0]
     try:
         status = kp.articulated_accelerations_packed(floats, ints, (table, forces),
                                                      carray(q, (nq,)), carray(u, (nu,)))
